@@ -1,0 +1,78 @@
+"""Le registre des figures : chaque figure du livre est une fonction nommée, sans argument, à graine fixe."""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from typing import Callable
+
+from matplotlib.figure import Figure
+
+from ..validation import KalmanInputError
+
+__all__ = ["CourseFigure", "FigureSpec", "REGISTRY", "register", "draw", "names", "new_figure"]
+
+#: Résolution des figures affichées dans les carnets (pixels par pouce).
+DISPLAY_DPI = 144
+
+
+class CourseFigure(Figure):
+    """Une ``Figure`` matplotlib qui s'affiche d'elle-même dans Jupyter (PNG), sans pyplot ni backend global."""
+
+    def _repr_png_(self):
+        buffer = io.BytesIO()
+        self.savefig(buffer, format="png", dpi=DISPLAY_DPI)
+        width, height = self.get_size_inches()
+        # affichée à 100 px par pouce, rendue à 144 : nette sur un écran haute densité
+        return buffer.getvalue(), {"width": int(width * 100), "height": int(height * 100)}
+
+    def __repr__(self) -> str:
+        return f"<Figure du cours {self.get_size_inches()[0]:.0f}×{self.get_size_inches()[1]:.0f} pouces>"
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """Une entrée du registre : nom (identifiant de fichier), chapitre, titre en français, fonction."""
+
+    name: str
+    chapter: str
+    title: str
+    build: Callable[[], Figure]
+
+
+REGISTRY: dict[str, FigureSpec] = {}
+
+
+def register(name: str, *, chapter: str, title: str):
+    """Décorateur : inscrit une fonction ``() -> Figure`` sous ``name`` (unique)."""
+
+    def decorator(func: Callable[[], Figure]) -> Callable[[], Figure]:
+        if name in REGISTRY:
+            raise RuntimeError(f"Figure « {name} » déjà enregistrée.")
+        REGISTRY[name] = FigureSpec(name=name, chapter=chapter, title=title, build=func)
+        return func
+
+    return decorator
+
+
+def names() -> list[str]:
+    """Noms de toutes les figures, dans l'ordre des chapitres."""
+    return list(REGISTRY)
+
+
+def draw(name: str) -> Figure:
+    """Construit la figure ``name`` (une nouvelle ``matplotlib.figure.Figure``, sans état global pyplot)."""
+    try:
+        spec = REGISTRY[name]
+    except KeyError:
+        raise KalmanInputError(
+            f"Figure inconnue « {name} ». Figures disponibles : {', '.join(REGISTRY)}."
+        ) from None
+    return spec.build()
+
+
+def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 7.0, height: float = 3.6, **kwargs):
+    """Une figure et ses axes, créés sans pyplot (rien de global n'est modifié)."""
+    fig = CourseFigure(figsize=(width, height), layout="constrained")
+    axes = fig.subplots(nrows, ncols, **kwargs)
+    return fig, axes

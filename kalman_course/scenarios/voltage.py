@@ -1,0 +1,38 @@
+r"""Scénario « tension constante » (Welch & Bishop) : modèle et relevés reproductibles."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..models import LinearGaussianModel
+from ..simulate import as_generator
+
+__all__ = [
+    "TRUE_VOLTAGE",
+    "VOLTAGE_NOISE_STD",
+    "VOLTAGE_SEED",
+    "constant_voltage_model",
+    "constant_voltage_measurements",
+]
+
+#: Tension vraie de l'exemple de Welch & Bishop (V).
+TRUE_VOLTAGE = -0.37727
+#: Écart-type du bruit du voltmètre (V) : :math:`\sigma = 0{,}1` V, donc :math:`\Psi = 0{,}01` V².
+VOLTAGE_NOISE_STD = 0.1
+#: Graine des mesures de l'exemple (toutes les figures du chapitre utilisent les mêmes relevés).
+VOLTAGE_SEED = 20260
+
+
+def constant_voltage_model(Q: float = 1e-5, R: float = VOLTAGE_NOISE_STD**2) -> LinearGaussianModel:
+    r"""Modèle de la tension constante : :math:`A = C = 1`, pas de commande, :math:`\Phi = Q`, :math:`\Psi = R`."""
+    return LinearGaussianModel(A=1.0, C=1.0, Q=Q, R=R)
+
+
+def constant_voltage_measurements(n_steps: int = 50, rng=VOLTAGE_SEED) -> np.ndarray:
+    r"""Relevés du voltmètre :math:`z_k = x + \psi_k`, :math:`\psi_k \sim \mathcal N(0, 0{,}1^2)`, forme (T,).
+
+    La tension vraie est constante (:data:`TRUE_VOLTAGE`) : le bruit d'état :math:`\Phi = 10^{-5}` du
+    filtre est une marge de modélisation, pas une dérive réelle (comme chez Welch & Bishop).
+    """
+    gen = as_generator(rng)
+    return TRUE_VOLTAGE + VOLTAGE_NOISE_STD * gen.standard_normal(n_steps)

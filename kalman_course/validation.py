@@ -1,0 +1,218 @@
+"""Vérification des entrées : toutes les erreurs destinées à l'utilisateur, en français, au même endroit.
+
+Chaque fonction reçoit le *nom* de l'argument tel que l'utilisateur l'a écrit (``"Q"``, ``"P0"``, ``"y"``…)
+afin que le message d'erreur le désigne. Rien n'est diffusé (*broadcast*) silencieusement : une forme
+incorrecte est une erreur.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+
+__all__ = [
+    "KalmanInputError",
+    "as_float_array",
+    "as_vector",
+    "as_matrix",
+    "as_square_matrix",
+    "check_symmetric",
+    "check_psd",
+    "check_pd",
+    "symmetric_tolerance",
+    "as_measurements",
+    "as_controls",
+    "check_control_allowed",
+]
+
+
+class KalmanInputError(ValueError):
+    """Entrée invalide : le message (en français) nomme l'argument et ce qui était attendu."""
+
+
+def _shape_text(shape: tuple[int, ...]) -> str:
+    if len(shape) == 0:
+        return "un scalaire"
+    return "(" + ", ".join(str(s) for s in shape) + ")"
+
+
+def as_float_array(name: str, value: Any, *, allow_nan: bool = False) -> np.ndarray:
+    """Convertit ``value`` en tableau ``float64`` (copie), en refusant le non numérique et le non fini.
+
+    ``allow_nan=True`` laisse passer les NaN (mesures manquantes) mais jamais les infinis.
+    """
+    if value is None:
+        raise KalmanInputError(f"« {name} » est absent (None) alors qu'un tableau numérique est attendu.")
+    try:
+        if np.iscomplexobj(np.asarray(value)):
+            raise KalmanInputError(f"« {name} » doit être réel, pas complexe.")
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, KalmanInputError):
+            raise
+        raise KalmanInputError(
+            f"« {name} » doit être un tableau de nombres réels ; conversion impossible ({type(value).__name__})."
+        ) from exc
+    if allow_nan:
+        if np.isinf(arr).any():
+            raise KalmanInputError(f"« {name} » contient des valeurs infinies.")
+    elif not np.isfinite(arr).all():
+        raise KalmanInputError(f"« {name} » contient des valeurs non finies (NaN ou infini).")
+    return arr
+
+
+def as_vector(name: str, value: Any, n: int) -> np.ndarray:
+    """Vecteur de taille ``n`` (forme ``(n,)``). Un scalaire est accepté si ``n == 1``.
+
+    Un vecteur colonne ``(n, 1)`` (convention de filterpy) est refusé avec un message explicite.
+    """
+    arr = as_float_array(name, value)
+    if arr.ndim == 0 and n == 1:
+        return arr.reshape(1)
+    if arr.shape != (n,):
+        hint = " (vecteur colonne : utilisez un tableau 1-D, par exemple x.ravel())" if arr.shape == (n, 1) else ""
+        raise KalmanInputError(
+            f"« {name} » doit être un vecteur de forme ({n},) ; reçu la forme {_shape_text(arr.shape)}{hint}."
+        )
+    return arr
+
+
+def as_matrix(
+    name: str, value: Any, rows: int | None, cols: int | None, free_rows: str = "m", free_cols: str = "p"
+) -> np.ndarray:
+    """Matrice 2-D ``(rows, cols)`` ; ``None`` : dimension libre, nommée ``free_rows``/``free_cols`` dans
+    le message. Un scalaire donne ``(1, 1)`` si permis."""
+    arr = as_float_array(name, value)
+    if arr.ndim == 0 and rows in (1, None) and cols in (1, None):
+        return arr.reshape(1, 1)
+    expected = f"({rows if rows is not None else free_rows}, {cols if cols is not None else free_cols})"
+    if arr.ndim != 2:
+        raise KalmanInputError(
+            f"« {name} » doit être une matrice 2-D de forme {expected} ; reçu la forme {_shape_text(arr.shape)}."
+        )
+    if (rows is not None and arr.shape[0] != rows) or (cols is not None and arr.shape[1] != cols):
+        raise KalmanInputError(
+            f"« {name} » doit être de forme {expected} ; reçu la forme {_shape_text(arr.shape)}."
+        )
+    if arr.shape[0] == 0 or arr.shape[1] == 0:
+        raise KalmanInputError(f"« {name} » est vide (forme {_shape_text(arr.shape)}).")
+    return arr
+
+
+def as_square_matrix(name: str, value: Any, n: int | None) -> np.ndarray:
+    """Matrice carrée ``(n, n)`` ; un scalaire est accepté pour ``n == 1`` (ou ``n`` libre)."""
+    arr = as_float_array(name, value)
+    if arr.ndim == 0 and n in (1, None):
+        return arr.reshape(1, 1)
+    if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
+        size = "n" if n is None else str(n)
+        raise KalmanInputError(
+            f"« {name} » doit être une matrice carrée ({size}, {size}) ; reçu la forme {_shape_text(arr.shape)}."
+        )
+    if n is not None and arr.shape[0] != n:
+        raise KalmanInputError(
+            f"« {name} » doit être de forme ({n}, {n}) ; reçu la forme {_shape_text(arr.shape)}."
+        )
+    if arr.shape[0] == 0:
+        raise KalmanInputError(f"« {name} » est vide.")
+    return arr
+
+
+def symmetric_tolerance(M: np.ndarray) -> float:
+    """Tolérance relative de symétrie : ``1e-9 · max(1, max|M|)``."""
+    return 1e-9 * max(1.0, float(np.max(np.abs(M))) if M.size else 1.0)
+
+
+def check_symmetric(name: str, M: np.ndarray) -> np.ndarray:
+    """Vérifie ``M = Mᵀ`` (à la tolérance près) et renvoie la partie symétrique ``(M + Mᵀ)/2``."""
+    asym = float(np.max(np.abs(M - M.T)))
+    if asym > symmetric_tolerance(M):
+        raise KalmanInputError(
+            f"« {name} » doit être symétrique (c'est une matrice de covariance) ; "
+            f"écart maximal |{name} − {name}ᵀ| = {asym:.3g}."
+        )
+    return 0.5 * (M + M.T)
+
+
+def check_psd(name: str, M: np.ndarray) -> np.ndarray:
+    """Symétrique semi-définie positive (valeurs propres ≥ −tolérance). Renvoie la partie symétrique."""
+    M = check_symmetric(name, M)
+    lam_min = float(scipy.linalg.eigvalsh(M)[0])
+    if lam_min < -1e-10 * max(1.0, float(np.max(np.abs(M)))):
+        raise KalmanInputError(
+            f"« {name} » doit être semi-définie positive (covariance) ; "
+            f"plus petite valeur propre = {lam_min:.3g} < 0."
+        )
+    return M
+
+
+def check_pd(name: str, M: np.ndarray) -> np.ndarray:
+    """Symétrique définie positive (la factorisation de Cholesky doit réussir). Renvoie la partie symétrique."""
+    M = check_symmetric(name, M)
+    try:
+        scipy.linalg.cholesky(M, lower=True, check_finite=False)
+    except np.linalg.LinAlgError:
+        lam_min = float(scipy.linalg.eigvalsh(M)[0])
+        raise KalmanInputError(
+            f"« {name} » doit être définie positive (covariance inversible) ; "
+            f"plus petite valeur propre = {lam_min:.3g}."
+        ) from None
+    return M
+
+
+def as_measurements(name: str, y: Any, m: int) -> np.ndarray:
+    """Mesures empilées ``(T, m)`` ; ``(T,)`` accepté si ``m = 1``.
+
+    Une mesure manquante s'écrit ``None`` ou ``NaN`` (toute la ligne ou seulement certaines composantes).
+    Les infinis sont refusés.
+    """
+    if isinstance(y, (list, tuple)):
+        missing = np.nan if m == 1 else [np.nan] * m
+        y = [missing if row is None else row for row in y]
+    arr = as_float_array(name, y, allow_nan=True)
+    if arr.ndim == 1 and m == 1:
+        arr = arr.reshape(-1, 1)
+    if arr.ndim != 2 or arr.shape[1] != m:
+        extra = " ou (T,)" if m == 1 else ""
+        raise KalmanInputError(
+            f"« {name} » doit être de forme (T, {m}){extra} : une ligne de {m} composante(s) par pas de temps ; "
+            f"reçu la forme {_shape_text(arr.shape)}."
+        )
+    if arr.shape[0] == 0:
+        raise KalmanInputError(f"« {name} » ne contient aucune mesure (T = 0).")
+    return arr
+
+
+def as_controls(name: str, u: Any, n_steps: int, p: int) -> np.ndarray | None:
+    """Commandes empilées ``(T, p)`` (``(T,)`` accepté si ``p = 1``), ou ``None`` sans commande.
+
+    Une commande fournie à un modèle sans matrice ``B`` (``p = 0``) est une erreur.
+    """
+    if u is None:
+        return None
+    check_control_allowed(name, p)
+    arr = as_float_array(name, u)
+    if arr.ndim == 1 and p == 1:
+        arr = arr.reshape(-1, 1)
+    if arr.ndim != 2 or arr.shape[1] != p:
+        extra = " ou (T,)" if p == 1 else ""
+        raise KalmanInputError(
+            f"« {name} » doit être de forme (T, {p}){extra} ; reçu la forme {_shape_text(arr.shape)}."
+        )
+    if arr.shape[0] != n_steps:
+        raise KalmanInputError(
+            f"« {name} » doit avoir une commande par pas de temps : {n_steps} ligne(s) attendue(s), "
+            f"{arr.shape[0]} reçue(s)."
+        )
+    return arr
+
+
+def check_control_allowed(name: str, p: int) -> None:
+    """Une commande n'a de sens que si le modèle a une matrice ``B`` (``p > 0``)."""
+    if p == 0:
+        raise KalmanInputError(
+            f"« {name} » est fourni mais le modèle n'a pas de matrice de commande B : "
+            f"construisez le modèle avec B=… ou retirez « {name} »."
+        )
