@@ -16,10 +16,11 @@ covariance bruit de mesure ``R``       :math:`\Psi` ``R``
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from .jacobians import numerical_jacobian, wrap_angle
 from .validation import (
     KalmanInputError,
     as_float_array,
@@ -29,7 +30,7 @@ from .validation import (
     check_psd,
 )
 
-__all__ = ["LinearGaussianModel"]
+__all__ = ["LinearGaussianModel", "NonlinearModel"]
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -115,3 +116,263 @@ class LinearGaussianModel:
 
     def __repr__(self) -> str:
         return f"LinearGaussianModel(n={self.n_state}, m={self.n_obs}, p={self.n_control})"
+
+
+# --------------------------------------------------------------------------- modèle non linéaire
+
+
+def _noise_jacobian_rows(name: str, value: Any) -> int | None:
+    """Nombre de lignes d'une jacobienne de bruit constante (None si absente ou appelable)."""
+    if value is None or callable(value):
+        return None
+    arr = as_float_array(name, value)
+    return arr.shape[0] if arr.ndim == 2 else None
+
+
+@dataclass(frozen=True, eq=False, init=False)
+class NonlinearModel:
+    r"""Système non linéaire à bruits gaussiens (notations du cours, :math:`n \to n+1`) :
+
+    .. math::
+
+        x_{n+1} = f(x_n, u_n) + W\phi_n,\qquad \phi_n \sim \mathcal N(0, Q)\quad(Q = \Phi \text{ du cours})
+
+        y_{n+1} = h(x_{n+1}) + V\psi_{n+1},\qquad \psi_{n+1} \sim \mathcal N(0, R)\quad(R = \Psi \text{ du cours})
+
+    C'est la forme linéarisée en bruit du modèle général :math:`x_{n+1} = f(x_n, u_n, \phi_n)`,
+    :math:`y_{n+1} = h(x_{n+1}, \psi_{n+1})` du cours : :math:`W = \partial f/\partial\phi` et
+    :math:`V = \partial h/\partial\psi`, évaluées en bruit nul. Sans ``W`` ni ``V`` les bruits sont additifs
+    (:math:`W = I`, :math:`V = I`), comme dans les notes du tag.
+
+    Paramètres
+    ----------
+    f : appelable ``f(x, u) -> (n,)``
+        Dynamique ; ``u`` vaut ``None`` quand il n'y a pas de commande (``n_control = 0``).
+    h : appelable ``h(x) -> (m,)``
+        Observation.
+    Q : (q, q)
+        Covariance du bruit d'état (semi-définie positive) ; ``q = n`` sans ``f_noise_jacobian``.
+    R : (r, r)
+        Covariance du bruit de mesure (définie positive) ; ``r = m`` sans ``h_noise_jacobian``.
+    f_jacobian : appelable ``(x, u) -> (n, n)`` ou matrice constante, optionnel
+        :math:`J^A = F = \partial f/\partial x`. Absente : différences centrées.
+    h_jacobian : appelable ``x -> (m, n)`` ou matrice constante, optionnel
+        :math:`J^H = H = \partial h/\partial x`. Absente : différences centrées.
+    f_noise_jacobian : appelable ``(x, u) -> (n, q)`` ou matrice constante, optionnel — :math:`W`.
+    h_noise_jacobian : appelable ``x -> (m, r)`` ou matrice constante, optionnel — :math:`V`.
+    n_state, n_obs : int, optionnels
+        Dimensions de l'état et de la mesure, déduites de ``Q``, ``R`` (ou de ``W``, ``V`` constantes) ;
+        à donner seulement si ``W`` ou ``V`` sont des fonctions qui changent la dimension.
+    n_control : int
+        Dimension ``p`` de la commande (0 : pas de commande, ``f`` reçoit ``u = None``).
+    angle_indices : indices des composantes de la mesure qui sont des angles (rad) : leurs résidus
+        :math:`y - h(x)` sont ramenés dans :math:`(-\pi, \pi]`.
+
+    Chaque appel de ``f``, ``h`` et des jacobiennes passe par les méthodes du modèle, qui vérifient la
+    forme et la finitude du résultat et lèvent une :class:`KalmanInputError` qui nomme la fonction fautive.
+    """
+
+    f: Callable[..., Any]
+    h: Callable[..., Any]
+    Q: np.ndarray
+    R: np.ndarray
+    f_jacobian: Any
+    h_jacobian: Any
+    f_noise_jacobian: Any
+    h_noise_jacobian: Any
+    n_state: int
+    n_obs: int
+    n_control: int
+    angle_indices: tuple[int, ...]
+
+    def __init__(
+        self,
+        f: Callable[..., Any],
+        h: Callable[..., Any],
+        Q: Any,
+        R: Any,
+        f_jacobian: Any = None,
+        h_jacobian: Any = None,
+        *,
+        f_noise_jacobian: Any = None,
+        h_noise_jacobian: Any = None,
+        n_state: int | None = None,
+        n_obs: int | None = None,
+        n_control: int = 0,
+        angle_indices: Sequence[int] = (),
+    ) -> None:
+        for name, func in (("f", f), ("h", h)):
+            if not callable(func):
+                raise KalmanInputError(
+                    f"« {name} » doit être une fonction (appelable) ; reçu {type(func).__name__}."
+                )
+        Q_arr = check_psd("Q", as_square_matrix("Q", Q, None))
+        R_arr = check_pd("R", as_square_matrix("R", R, None))
+        n = _dimension("n_state", n_state, f_noise_jacobian, "f_noise_jacobian", Q_arr.shape[0])
+        m = _dimension("n_obs", n_obs, h_noise_jacobian, "h_noise_jacobian", R_arr.shape[0])
+        if not isinstance(n_control, (int, np.integer)) or isinstance(n_control, bool) or n_control < 0:
+            raise KalmanInputError(f"« n_control » doit être un entier ≥ 0 ; reçu {n_control!r}.")
+        angles = tuple(int(i) for i in np.atleast_1d(np.asarray(angle_indices, dtype=int)))
+        for i in angles:
+            if not 0 <= i < m:
+                raise KalmanInputError(
+                    f"« angle_indices » doit désigner des composantes de la mesure (0 à {m - 1}) ; reçu {i}."
+                )
+        q, r = Q_arr.shape[0], R_arr.shape[0]
+        object.__setattr__(self, "f", f)
+        object.__setattr__(self, "h", h)
+        object.__setattr__(self, "Q", _readonly(Q_arr))
+        object.__setattr__(self, "R", _readonly(R_arr))
+        object.__setattr__(self, "f_jacobian", _constant_or_callable("f_jacobian", f_jacobian, (n, n)))
+        object.__setattr__(self, "h_jacobian", _constant_or_callable("h_jacobian", h_jacobian, (m, n)))
+        object.__setattr__(
+            self, "f_noise_jacobian", _constant_or_callable("f_noise_jacobian", f_noise_jacobian, (n, q))
+        )
+        object.__setattr__(
+            self, "h_noise_jacobian", _constant_or_callable("h_noise_jacobian", h_noise_jacobian, (m, r))
+        )
+        if f_noise_jacobian is None and q != n:
+            raise KalmanInputError(
+                f"« Q » doit être de forme ({n}, {n}) (bruit d'état additif) ; reçu ({q}, {q}). "
+                f"Pour un bruit de dimension {q}, donnez f_noise_jacobian (W, de forme ({n}, {q}))."
+            )
+        if h_noise_jacobian is None and r != m:
+            raise KalmanInputError(
+                f"« R » doit être de forme ({m}, {m}) (bruit de mesure additif) ; reçu ({r}, {r}). "
+                f"Pour un bruit de dimension {r}, donnez h_noise_jacobian (V, de forme ({m}, {r}))."
+            )
+        object.__setattr__(self, "n_state", int(n))
+        object.__setattr__(self, "n_obs", int(m))
+        object.__setattr__(self, "n_control", int(n_control))
+        object.__setattr__(self, "angle_indices", angles)
+
+    # ------------------------------------------------------------------ évaluations vérifiées
+
+    def transition(self, x: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
+        r""":math:`f(x, u)`, forme (n,), vérifiée (taille, valeurs finies)."""
+        return _checked_vector("f", _call("f", self.f, x, (u,)), self.n_state, "n", x)
+
+    def observe(self, x: np.ndarray) -> np.ndarray:
+        r""":math:`h(x)`, forme (m,), vérifiée (taille, valeurs finies)."""
+        return _checked_vector("h", _call("h", self.h, x, ()), self.n_obs, "m", x)
+
+    def transition_jacobian(self, x: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
+        r""":math:`F = J^A = \partial f/\partial x` en :math:`(x, u)`, forme (n, n) (analytique ou différences centrées)."""
+        if self.f_jacobian is None:
+            return numerical_jacobian(lambda z: self.transition(z, u), x, name="f")
+        return _checked_matrix("f_jacobian", self.f_jacobian, x, (u,), (self.n_state, self.n_state))
+
+    def observation_jacobian(self, x: np.ndarray) -> np.ndarray:
+        r""":math:`H = J^H = \partial h/\partial x` en :math:`x`, forme (m, n) (analytique ou différences centrées)."""
+        if self.h_jacobian is None:
+            return numerical_jacobian(self.observe, x, angle_indices=self.angle_indices, name="h")
+        return _checked_matrix("h_jacobian", self.h_jacobian, x, (), (self.n_obs, self.n_state))
+
+    def process_noise(self, x: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
+        r"""Covariance du bruit d'état ramenée à l'état, :math:`W Q W^T` (n, n) (:math:`Q` si bruit additif)."""
+        if self.f_noise_jacobian is None:
+            return self.Q
+        W = _checked_matrix(
+            "f_noise_jacobian", self.f_noise_jacobian, x, (u,), (self.n_state, self.Q.shape[0])
+        )
+        return W.dot(self.Q).dot(W.T)
+
+    def measurement_noise(self, x: np.ndarray) -> np.ndarray:
+        r"""Covariance du bruit de mesure ramenée à la mesure, :math:`V R V^T` (m, m) (:math:`R` si additif)."""
+        if self.h_noise_jacobian is None:
+            return self.R
+        V = _checked_matrix("h_noise_jacobian", self.h_noise_jacobian, x, (), (self.n_obs, self.R.shape[0]))
+        return V.dot(self.R).dot(V.T)
+
+    def residual(self, y: np.ndarray, y_hat: np.ndarray) -> np.ndarray:
+        r"""Résidu :math:`y - \hat y`, les composantes angulaires ramenées dans :math:`(-\pi, \pi]`."""
+        d = y - y_hat
+        if self.angle_indices:
+            idx = list(self.angle_indices)
+            d[idx] = wrap_angle(d[idx])
+        return d
+
+    @classmethod
+    def from_linear(cls, model: LinearGaussianModel) -> "NonlinearModel":
+        r"""Le modèle linéaire :math:`f(x, u) = Ax + Bu`, :math:`h(x) = Cx`, vu comme un modèle non linéaire
+        (jacobiennes constantes :math:`A` et :math:`C`). Sert à vérifier que l'EKF redonne alors le KF."""
+        A, B, C = model.A, model.B, model.C
+
+        def f(x, u):
+            return A @ x if u is None else A @ x + B @ u
+
+        return cls(f, lambda x: C @ x, model.Q, model.R, f_jacobian=A, h_jacobian=C,
+                   n_control=model.n_control)
+
+    def __repr__(self) -> str:
+        return f"NonlinearModel(n={self.n_state}, m={self.n_obs}, p={self.n_control})"
+
+
+def _dimension(name: str, given: Any, noise_jac: Any, noise_name: str, default: int) -> int:
+    if given is not None:
+        if not isinstance(given, (int, np.integer)) or isinstance(given, bool) or given < 1:
+            raise KalmanInputError(f"« {name} » doit être un entier ≥ 1 ; reçu {given!r}.")
+        return int(given)
+    rows = _noise_jacobian_rows(noise_name, noise_jac)
+    if rows is not None:
+        return rows
+    if callable(noise_jac):
+        raise KalmanInputError(
+            f"« {noise_name} » est une fonction : donnez aussi « {name} » (la dimension ne peut pas être déduite)."
+        )
+    return default
+
+
+def _constant_or_callable(name: str, value: Any, shape: tuple[int, int]) -> Any:
+    """Une jacobienne : ``None``, une fonction, ou une matrice constante de forme ``shape`` (lecture seule)."""
+    if value is None or callable(value):
+        return value
+    return _readonly(as_matrix(name, value, shape[0], shape[1]))
+
+
+def _call(name: str, func: Callable[..., Any], x: np.ndarray, args: tuple) -> Any:
+    try:
+        return func(x, *args)
+    except KalmanInputError:
+        raise
+    except Exception as exc:  # noqa: BLE001 — l'erreur de l'utilisateur, nommée
+        raise KalmanInputError(
+            f"La fonction « {name} » a échoué en x = {np.array2string(np.asarray(x), precision=4)} : "
+            f"{type(exc).__name__}: {exc}"
+        ) from exc
+
+
+def _checked_vector(name: str, value: Any, size: int, letter: str, x: np.ndarray) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0 and size == 1:
+        arr = arr.reshape(1)
+    if arr.shape != (size,):
+        what = "l'état" if letter == "n" else "la mesure"
+        raise KalmanInputError(
+            f"La fonction « {name} » doit renvoyer un vecteur de forme ({size},) ({letter} = {size}, "
+            f"dimension de {what}) ; elle a renvoyé la forme {arr.shape}."
+        )
+    if not np.isfinite(arr).all():
+        raise KalmanInputError(
+            f"La fonction « {name} » a renvoyé des valeurs non finies (NaN ou infini) en "
+            f"x = {np.array2string(np.asarray(x), precision=4)}."
+        )
+    return arr
+
+
+def _checked_matrix(name: str, value: Any, x: np.ndarray, args: tuple, shape: tuple[int, int]) -> np.ndarray:
+    if callable(value):
+        value = _call(name, value, x, args)
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0 and shape == (1, 1):
+        arr = arr.reshape(1, 1)
+    if arr.shape != shape:
+        raise KalmanInputError(
+            f"La jacobienne « {name} » doit être de forme {shape} ; elle a la forme {arr.shape}."
+        )
+    if not np.isfinite(arr).all():
+        raise KalmanInputError(
+            f"La jacobienne « {name} » contient des valeurs non finies (NaN ou infini) en "
+            f"x = {np.array2string(np.asarray(x), precision=4)}."
+        )
+    return arr

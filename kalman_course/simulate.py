@@ -10,9 +10,9 @@ import scipy.linalg
 
 from .models import LinearGaussianModel
 from .results import freeze
-from .validation import KalmanInputError, as_controls, as_vector
+from .validation import KalmanInputError, as_controls, as_square_matrix, as_vector, check_psd
 
-__all__ = ["Simulation", "simulate", "as_generator", "covariance_factor"]
+__all__ = ["MonteCarlo", "Simulation", "as_generator", "covariance_factor", "monte_carlo", "simulate"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,3 +74,91 @@ def simulate(model: LinearGaussianModel, x0: Any, n_steps: int, u: Any = None, *
         xs[k] = x
     ys = xs @ model.C.T + v
     return Simulation(x=xs, y=ys)
+
+
+@dataclass(frozen=True, eq=False)
+class MonteCarlo:
+    r"""Résultat de :func:`monte_carlo` sur ``R`` tirages indépendants de ``T`` pas.
+
+    ``x0`` (R, n) : états initiaux vrais :math:`x_0` ; ``x`` (R, T, n) : :math:`x_1 \dots x_T` ;
+    ``y`` (R, T, m) : mesures ; ``x_hat`` (R, T, n) : estimations :math:`\hat x_1 \dots \hat x_T` ;
+    ``x0_hat`` (n,) : l'estimation initiale :math:`\hat x_0` commune à tous les tirages.
+    """
+
+    x0: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    x_hat: np.ndarray
+    x0_hat: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("x0", "x", "y", "x_hat", "x0_hat"):
+            object.__setattr__(self, name, freeze(getattr(self, name)))
+
+    @property
+    def n_runs(self) -> int:
+        """Nombre de tirages ``R``."""
+        return self.x.shape[0]
+
+    @property
+    def errors(self) -> np.ndarray:
+        r"""Erreurs :math:`e_n = \hat x_n - x_n` (signe du cours) pour :math:`n = 0 \dots T`, forme (R, T+1, n)."""
+        e0 = self.x0_hat[None, :] - self.x0
+        return np.concatenate([e0[:, None, :], self.x_hat - self.x], axis=1)
+
+    def mean_error(self) -> np.ndarray:
+        r"""Moyenne empirique :math:`\overline{e_n}` sur les tirages, forme (T+1, n)."""
+        return self.errors.mean(axis=0)
+
+    def mean_error_sem(self) -> np.ndarray:
+        r"""Écart-type de la moyenne empirique (erreur standard :math:`s/\sqrt R`), forme (T+1, n)."""
+        return self.errors.std(axis=0, ddof=1) / np.sqrt(self.n_runs)
+
+
+def monte_carlo(
+    model: LinearGaussianModel,
+    estimator: Any,
+    n_steps: int,
+    n_runs: int,
+    *,
+    x0_mean: Any,
+    x0_cov: Any,
+    x0_hat: Any,
+    rng: Any,
+    u: Any = None,
+) -> MonteCarlo:
+    r"""Expérience de Monte-Carlo : ``n_runs`` trajectoires indépendantes, chacune estimée.
+
+    Pour chaque tirage : :math:`x_0 \sim \mathcal N(\bar x_0, \Sigma_0)` (``x0_mean``, ``x0_cov``), puis
+    :func:`simulate` sur ``n_steps`` pas (bruits :math:`\phi, \psi` tirés du même générateur), puis
+    ``estimator(y)`` qui doit renvoyer les estimations :math:`\hat x_1 \dots \hat x_T` de forme (T, n),
+    par exemple ``lambda y: kalman_filter(model, y, x0_hat, P0).x``.
+
+    ``x0_hat`` (n,) est l'estimation initiale utilisée par ``estimator`` ; elle ne sert ici qu'à
+    calculer :math:`e_0`. ``rng`` : graine entière ou ``numpy.random.Generator`` (obligatoire).
+    """
+    if not isinstance(n_runs, (int, np.integer)) or isinstance(n_runs, bool) or n_runs < 2:
+        raise KalmanInputError(f"« n_runs » doit être un entier ≥ 2 ; reçu {n_runs!r}.")
+    if not callable(estimator):
+        raise KalmanInputError(
+            f"« estimator » doit être une fonction y (T, m) → x̂ (T, n) ; reçu {type(estimator).__name__}."
+        )
+    gen = as_generator(rng)
+    n = model.n_state
+    mean = as_vector("x0_mean", x0_mean, n)
+    cov = check_psd("x0_cov", as_square_matrix("x0_cov", x0_cov, n))
+    x0_hat_arr = as_vector("x0_hat", x0_hat, n)
+    L0 = covariance_factor(cov)
+    x0s = mean + gen.standard_normal((n_runs, n)) @ L0.T
+    xs, ys, xhs = [], [], []
+    for r in range(n_runs):
+        sim = simulate(model, x0s[r], n_steps, u, rng=gen)
+        x_hat = np.asarray(estimator(sim.y), dtype=float)
+        if x_hat.shape != (n_steps, n):
+            raise KalmanInputError(
+                f"« estimator » doit renvoyer un tableau de forme ({n_steps}, {n}) ; reçu {x_hat.shape}."
+            )
+        xs.append(sim.x)
+        ys.append(sim.y)
+        xhs.append(x_hat)
+    return MonteCarlo(x0=x0s, x=np.array(xs), y=np.array(ys), x_hat=np.array(xhs), x0_hat=x0_hat_arr)

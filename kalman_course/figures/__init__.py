@@ -4,7 +4,15 @@ Les chapitres appellent ``draw`` ; la commande ``python -m kalman_course.figures
 figures dans des fichiers (diapositives, polycopiés). Une figure = une fonction à graine fixe.
 """
 
+from . import system  # noqa: F401  (chapitre « Contrôle d'un système dynamique »)
+from . import estimator  # noqa: F401  (chapitre « Construction d'un estimateur »)
+from . import gain  # noqa: F401  (chapitres « Prédicteur–correcteur » et « Gain optimal »)
 from . import voltage  # noqa: F401  (enregistre les figures du chapitre)
+from . import practice  # noqa: F401  (chapitre « Implémentation pratique et synthèse »)
+from . import ekf  # noqa: F401  (chapitre « Dynamique non linéaire — le filtre de Kalman étendu »)
+from . import tag  # noqa: F401  (chapitre « Exemple — suivi d'un tag radio (UWB) »)
+from . import iekf  # noqa: F401  (chapitre « Filtre de Kalman étendu itéré »)
+from . import ukf  # noqa: F401  (chapitre « Pour aller plus loin » : UKF de filterpy)
 from ._registry import REGISTRY, FigureSpec, draw, names, new_figure, register
 
 __all__ = ["REGISTRY", "FigureSpec", "draw", "names", "new_figure", "register"]

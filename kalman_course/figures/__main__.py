@@ -6,18 +6,38 @@ import argparse
 import sys
 from pathlib import Path
 
+import matplotlib
 from tqdm import tqdm
 
 from . import REGISTRY, draw
 
 FORMATS = ("png", "svg", "pdf")
+# Métadonnées sans date : des fichiers identiques d'une régénération à l'autre.
+_FIXED_METADATA = {"png": None, "svg": {"Date": None}, "pdf": {"CreationDate": None}}
+
+
+class _FrenchHelpFormatter(argparse.HelpFormatter):
+    def add_usage(self, usage, actions, groups, prefix=None):
+        return super().add_usage(usage, actions, groups, prefix="utilisation : ")
+
+
+class _FrenchParser(argparse.ArgumentParser):
+    """``argparse`` dont les textes fixes (utilisation, erreur, aide) sont en français."""
+
+    def error(self, message: str):
+        self.print_usage(sys.stderr)
+        self.exit(2, f"{self.prog} : erreur : {message}\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _FrenchParser(
         prog="python -m kalman_course.figures",
         description="Régénère les figures du cours « Filtre de Kalman » dans des fichiers.",
+        formatter_class=_FrenchHelpFormatter,
+        add_help=False,
     )
+    parser._optionals.title = "options"
+    parser.add_argument("-h", "--help", action="help", help="afficher cette aide et quitter")
     parser.add_argument("--out", type=Path, help="dossier de sortie (créé si besoin)")
     parser.add_argument(
         "--format",
@@ -49,13 +69,14 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"figure(s) inconnue(s) : {', '.join(missing)} (voir --list)")
     args.out.mkdir(parents=True, exist_ok=True)
     written = 0
-    for name in tqdm(selected, desc="figures", unit="fig", file=sys.stderr):
-        fig = draw(name)
-        for fmt in formats:
-            # metadata figée : deux régénérations donnent les mêmes fichiers
-            meta = {"Date": None} if fmt in ("pdf", "svg") else {}
-            fig.savefig(args.out / f"{name}.{fmt}", dpi=args.dpi, metadata=meta or None)
-            written += 1
+    # Date retirée des métadonnées et identifiants SVG déterministes (réglage local à cette boucle) :
+    # deux régénérations écrivent les mêmes octets.
+    with matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
+        for name in tqdm(selected, desc="figures", unit="fig", file=sys.stderr):
+            fig = draw(name)
+            for fmt in formats:
+                fig.savefig(args.out / f"{name}.{fmt}", dpi=args.dpi, metadata=_FIXED_METADATA[fmt])
+                written += 1
     print(f"{written} fichier(s) écrit(s) dans {args.out}")
     return 0
 

@@ -7,8 +7,21 @@ from .voltage import (
     constant_voltage_measurements,
     constant_voltage_model,
 )
+from . import engine, radar, tag  # noqa: F401  (moteur 2×2 ; suivi du tag UWB ; radar de l'EKF itéré)
+from .radar import radar_iterations, radar_update_problem
+from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
 __all__ = [
+    "engine",
+    "position_rmse",
+    "radar",
+    "radar_iterations",
+    "radar_update_problem",
+    "run_tag_ekf",
+    "run_tag_ukf",
+    "tag",
+    "tag_data",
+    "tag_model",
     "TRUE_VOLTAGE",
     "VOLTAGE_NOISE_STD",
     "VOLTAGE_SEED",

@@ -1,0 +1,236 @@
+"""Mesures de l'interactivité du livre, comparées aux objectifs (rien n'est un test chronométré).
+
+1. Précalcul des grilles : 15 × 15 exécutions de 50 pas (tension constante), objectif < 1 s ;
+   7 × 7 exécutions de 300 pas de l'EKF du tag, pour information.
+2. Poids de la page interactive (site construit) : HTML propre + données précalculées + images, objectif
+   < 1 Mo ; scripts partagés par tout le site (BokehJS, MathJax, thème), chargés une fois, à part.
+3. Réponse des curseurs dans Chromium headless : de l'événement clavier réel (touche flèche sur la
+   poignée) à la recopie des données (rappel CustomJS), puis à la fin du rendu des panneaux par BokehJS
+   (fin du dernier requestAnimationFrame qu'il a demandé) ; objectif < 50 ms.
+
+Usage : python benchmarks/interactive.py [--site _build/html] [--moves 40]
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import http.server
+import re
+import statistics
+import threading
+import time
+from pathlib import Path
+from urllib.parse import urlsplit
+
+import kalman_course.interactive as ki
+from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
+
+CHROMIUM_ARGS = [
+    "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+]
+PAGES = ["book/tension-constante.html", "book/suivi-tag.html"]
+PLAIN_PAGE = "book/intro.html"  # page du thème sans figure interactive, pour comparaison
+
+
+def best_time(func, repeat: int = 5) -> float:
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def bench_grids() -> None:
+    print("1. Précalcul des grilles (meilleur de 5)")
+    ki.voltage_grid()  # échauffement (imports, caches)
+    t = best_time(ki.voltage_grid)
+    g = ki.voltage_grid()
+    n = g.shape[0] * g.shape[1]
+    print(f"   tension constante  {g.shape[0]}×{g.shape[1]} exécutions × {g.time.size} pas : {t * 1e3:7.1f} ms"
+          f"  (objectif < 1000 ms : {'atteint' if t < 1 else 'MANQUÉ'}, {t / n * 1e6:.0f} µs par exécution)")
+    t = best_time(ki.tag_grid, repeat=2)
+    g = ki.tag_grid()
+    print(f"   tag UWB (EKF)      {g.shape[0]}×{g.shape[1]} exécutions × {g.time.size} pas : {t * 1e3:7.1f} ms")
+    t = best_time(lambda: ki.voltage_sliders().html(), repeat=3)
+    print(f"   figure Bokeh complète de la tension (grille + document + HTML) : {t * 1e3:7.1f} ms")
+
+
+def serve(root: Path):
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *args):
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=str(root)))
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server, f"http://127.0.0.1:{server.server_address[1]}/"
+
+
+def open_page(browser, url: str, base: str):
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    loaded, blocked = [], []
+
+    def route(r):
+        if r.request.url.startswith(base) or r.request.url.startswith("data:"):
+            r.continue_()
+        else:
+            blocked.append(r.request.url)
+            r.abort()
+
+    page.route("**/*", route)
+    page.on("response", lambda r: loaded.append(r.url) if r.status < 400 else None)
+    page.goto(url, wait_until="load")
+    page.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise.then(() => true) : true")
+    return page, loaded, blocked
+
+
+def weight(root: Path, html_file: Path, loaded: list[str]) -> dict[str, int]:
+    html = html_file.read_text()
+    data = sum(len(m.encode()) for m in re.findall(r'<script type="application/json" id="kc-[^"]*">(.*?)</script>',
+                                                     html, re.S))
+    images = {(html_file.parent / s).resolve() for s in re.findall(r'<img[^>]+src="([^"]+)"', html)}
+    out = {"html": html_file.stat().st_size - data, "data": data,
+           "images": sum(f.stat().st_size for f in images if f.is_file()), "bokeh": 0, "mathjax": 0, "theme": 0}
+    for url in dict.fromkeys(loaded):
+        f = (root / urlsplit(url).path.lstrip("/")).resolve()
+        if not f.is_file() or f == html_file.resolve() or f in images:
+            continue
+        rel = f.relative_to(root.resolve()).as_posix()
+        key = "bokeh" if rel.startswith("_static/bokeh/") else "mathjax" if rel.startswith("_static/mathjax/") \
+            else None if rel.startswith("_images/") else "theme"
+        if key:
+            out[key] += f.stat().st_size
+    return out
+
+
+_INSTALL = """(k) => {
+  // t0 : horodatage de l'événement clavier réel (même horloge que performance.now()) ;
+  // tData : le document Bokeh signale le changement des données tracées (rappel CustomJS terminé) ;
+  // tPaint : fin du dernier rendu que BokehJS a demandé (requestAnimationFrame) après cet événement,
+  // c'est-à-dire les trois panneaux redessinés.
+  const doc = Bokeh.documents[k];
+  const src = doc.get_model_by_name('%s');
+  window.kcMoves = [];
+  let current = null;
+  document.addEventListener('keydown', (e) => {
+    current = {t0: e.timeStamp, tData: null, tPaint: null};
+    window.kcMoves.push(current);
+  }, true);
+  doc.on_change((ev) => {
+    if (current && ev.model === src && ev.attr === 'data') current.tData = performance.now() - current.t0;
+  });
+  const raf = window.requestAnimationFrame.bind(window);
+  window.requestAnimationFrame = (cb) => {
+    const move = current;
+    return raf((t) => {
+      cb(t);
+      if (move && move.tData !== null) move.tPaint = Math.max(move.tPaint || 0, performance.now() - move.t0);
+    });
+  };
+}""" % PLOTTED_SOURCE
+
+
+def bench_browser(root: Path, moves: int) -> None:
+    from playwright.sync_api import sync_playwright
+
+    server, base = serve(root)
+    try:
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+            print("\n2. Poids des pages (octets des fichiers chargés ; scripts partagés chargés une fois par site)")
+            for rel in [PLAIN_PAGE, *PAGES]:
+                html_file = root / rel
+                if not html_file.is_file():
+                    print(f"   {rel} : absente du site")
+                    continue
+                page, loaded, blocked = open_page(browser, base + rel, base)
+                page.wait_for_timeout(500)
+                w = weight(root, html_file, loaded)
+                own = w["html"] + w["data"] + w["images"]
+                shared = w["bokeh"] + w["mathjax"] + w["theme"]
+                target = ""
+                if MARKER in html_file.read_text():
+                    target = f"  (objectif < 1 Mo : {'atteint' if own < 1e6 else 'MANQUÉ'})"
+                print(f"   {rel}")
+                print(f"     propre : HTML {w['html'] / 1e3:6.0f} ko + données {w['data'] / 1e3:6.0f} ko + images "
+                      f"{w['images'] / 1e3:6.0f} ko = {own / 1e6:.3f} Mo{target}")
+                print(f"     partagé : BokehJS {w['bokeh'] / 1e6:.3f} Mo, MathJax {w['mathjax'] / 1e6:.3f} Mo, "
+                      f"thème {w['theme'] / 1e6:.3f} Mo ; total chargé {(own + shared) / 1e6:.3f} Mo")
+                if blocked:
+                    print(f"     REQUÊTES NON LOCALES BLOQUÉES : {blocked}")
+                page.close()
+
+            print(f"\n3. Réponse des curseurs dans Chromium headless ({moves} déplacements au clavier par curseur)")
+            for rel in PAGES:
+                html_file = root / rel
+                if not html_file.is_file() or MARKER not in html_file.read_text():
+                    continue
+                page, _, _ = open_page(browser, base + rel, base)
+                page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0")
+                figures = page.locator(f"[{MARKER}]")
+                for k in range(figures.count()):
+                    name = figures.nth(k).get_attribute(MARKER)
+                    page.locator(f"[{MARKER}] .noUi-handle").first.wait_for()
+                    page.evaluate(_INSTALL, k)
+                    for s in (0, 1):
+                        handle = figures.nth(k).locator(".noUi-handle").nth(s)
+                        handle.focus()
+                        page.keyboard.press("Home")
+                        page.wait_for_timeout(300)
+                        page.evaluate("() => { window.kcMoves = []; }")
+                        n_pos = int(page.evaluate(f"() => Bokeh.documents[{k}].get_model_by_name('kc-slider-{s}').end"))
+                        key = "ArrowRight"
+                        for m in range(moves):
+                            value = page.evaluate(f"() => Bokeh.documents[{k}].get_model_by_name('kc-slider-{s}').value")
+                            if value >= n_pos:
+                                key = "ArrowLeft"
+                            elif value <= 0:
+                                key = "ArrowRight"
+                            page.keyboard.press(key)
+                            page.wait_for_timeout(150)  # laisser finir le rendu avant le mouvement suivant
+                        done = [m for m in page.evaluate("() => window.kcMoves") if m["tPaint"] is not None]
+                        data_ms = [m["tData"] for m in done]
+                        paint_ms = [m["tPaint"] for m in done]
+                        label = page.evaluate(f"() => Bokeh.documents[{k}].get_model_by_name('kc-slider-{s}').title")
+                        med, p90 = statistics.median(paint_ms), statistics.quantiles(paint_ms, n=10)[-1]
+                        worst = max(paint_ms)
+                        verdict = "atteint" if worst < 50 else ("atteint pour 90 % des mouvements" if p90 < 50
+                                                               else "MANQUÉ")
+                        print(f"   {name}, « {label} » ({len(done)} mouvements) :\n"
+                              f"     données recopiées : médiane {statistics.median(data_ms):5.1f} ms, "
+                              f"max {max(data_ms):5.1f} ms\n"
+                              f"     figure redessinée : médiane {med:5.1f} ms, 90 % {p90:5.1f} ms, max {worst:5.1f} ms"
+                              f" — objectif < 50 ms : {verdict}")
+                page.close()
+            browser.close()
+    finally:
+        server.shutdown()
+
+
+def load_note() -> str:
+    try:
+        import os
+
+        return f"charge moyenne de la machine (1 min) : {os.getloadavg()[0]:.2f} pour {os.cpu_count()} cœurs"
+    except OSError:
+        return ""
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description="Mesures de l'interactivité du livre (grilles, poids, réponse).")
+    parser.add_argument("--site", type=Path, default=Path("_build/html"), help="dossier html du site construit")
+    parser.add_argument("--moves", type=int, default=40, help="déplacements mesurés par curseur")
+    args = parser.parse_args()
+    bench_grids()
+    if not (args.site / PAGES[0]).is_file():
+        print(f"\n(site absent dans {args.site} : construisez le livre pour mesurer le poids et la réponse)")
+        return 0
+    bench_browser(args.site.resolve(), args.moves)
+    print(f"\n({load_note()} ; les maxima dépendent de la charge, les médianes bougent peu)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,126 @@
+"""Figures du chapitre « Construction d'un estimateur » : récurrence de l'erreur moyenne, stabilité."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..estimator import linear_estimator, mean_error_recursion
+from ..kf import kalman_filter
+from ..models import LinearGaussianModel
+from ..scenarios.engine import (
+    ENGINE_DT,
+    ENGINE_SEED,
+    ENGINE_X0_COV,
+    ENGINE_X0_HAT,
+    ENGINE_X0_MEAN,
+    engine_commands,
+    engine_model,
+)
+from ..simulate import monte_carlo, simulate
+from ._registry import new_figure, register
+
+CHAPTER = "estimateur"
+
+#: Taille des expériences de Monte-Carlo du chapitre.
+N_RUNS = 400
+N_STEPS = 60
+#: Covariance initiale du filtre dans ce chapitre (°C²) : le filtre se croit précis à 1 °C près alors que
+#: son estimation initiale ENGINE_X0_HAT est fausse de 15 °C ; l'erreur moyenne décroît donc sur plusieurs pas.
+OVERCONFIDENT_P0 = np.eye(2)
+
+
+def engine_kalman_gains(n_steps: int = N_STEPS) -> np.ndarray:
+    """Gains du filtre de Kalman du moteur, (T, 2, 2) : ils ne dépendent pas des mesures (une seule course suffit)."""
+    model = engine_model()
+    u = engine_commands(n_steps)
+    y = simulate(model, ENGINE_X0_MEAN, n_steps, u, rng=0).y
+    return kalman_filter(model, y, ENGINE_X0_HAT, OVERCONFIDENT_P0, u).K
+
+
+def mean_error_experiment(forget_command: bool, n_steps: int = N_STEPS, n_runs: int = N_RUNS):
+    """Erreur moyenne de l'estimateur du moteur : Monte-Carlo et récurrence du cours.
+
+    ``forget_command=False`` : le filtre de Kalman (conditions suffisantes respectées) ;
+    ``True`` : mêmes gains mais :math:`B_f = 0` (condition 1 violée : l'estimateur oublie la commande).
+    Renvoie ``(monte_carlo, recursion)``.
+    """
+    model = engine_model()
+    u = engine_commands(n_steps)
+    K = engine_kalman_gains(n_steps)
+    B_f = np.zeros((2, 1)) if forget_command else None
+
+    def estimator(y):
+        return linear_estimator(model, y, ENGINE_X0_HAT, K, u=u, B_f=B_f)
+
+    mc = monte_carlo(
+        model, estimator, n_steps, n_runs,
+        x0_mean=ENGINE_X0_MEAN, x0_cov=ENGINE_X0_COV, x0_hat=ENGINE_X0_HAT, rng=ENGINE_SEED, u=u,
+    )
+    rec = mean_error_recursion(model, K, x0_mean=ENGINE_X0_MEAN, x0_hat=ENGINE_X0_HAT, u=u, B_f=B_f)
+    return mc, rec
+
+
+def _mean_error_panel(ax, mc, rec, title: str) -> None:
+    t = ENGINE_DT * np.arange(rec.e.shape[0])
+    mean, sem = mc.mean_error(), mc.mean_error_sem()
+    for i, (color, label) in enumerate([("tab:red", r"\theta_m"), ("tab:blue", r"\theta_a")]):
+        ax.plot(t, rec.e[:, i], color=color, lw=1.6, label=f"récurrence du cours, ${label}$")
+        ax.errorbar(
+            t[::2], mean[::2, i], yerr=2 * sem[::2, i], fmt="o", ms=3, color=color, alpha=0.6, elinewidth=0.8,
+            label=f"Monte-Carlo ({mc.n_runs} tirages) ± 2 σ, ${label}$",
+        )
+    ax.axhline(0.0, color="0.3", lw=0.8)
+    ax.set_ylabel(r"erreur moyenne $\mathbb{E}[e_n]$ (°C)")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper right", ncol=2)
+
+
+@register("estimateur-erreur-moyenne", chapter=CHAPTER, title="Erreur moyenne : Monte-Carlo contre la récurrence")
+def mean_error_figure():
+    fig, axes = new_figure(2, 1, width=7.0, height=6.4, sharex=True)
+    mc, rec = mean_error_experiment(forget_command=False)
+    _mean_error_panel(axes[0], mc, rec, r"Conditions respectées : $A_f = (I-KC)A$, $B_f = (I-KC)B$")
+    mc, rec = mean_error_experiment(forget_command=True)
+    _mean_error_panel(axes[1], mc, rec, r"Condition 1 violée : $B_f = 0$ (l'estimateur oublie la commande)")
+    axes[1].set_xlabel("temps (s)")
+    return fig
+
+
+#: Contre-exemple de l'erratum 001-3 : système instable, mesure directe.
+COUNTER_EXAMPLE = dict(A=2.0, C=1.0, Q=0.01, R=0.01)
+COUNTER_GAINS = (0.4, 0.6)
+
+
+def stability_experiment(K: float, n_steps: int = 20, n_runs: int = 400):
+    """Gain fixe ``K`` sur le contre-exemple :math:`A = 2, C = 1` : Monte-Carlo et récurrence, :math:`\\hat x_0 - x_0 = 1`."""
+    model = LinearGaussianModel(**COUNTER_EXAMPLE)
+    Kmat = np.array([[K]])
+
+    def estimator(y):
+        return linear_estimator(model, y, [1.0], Kmat)
+
+    mc = monte_carlo(model, estimator, n_steps, n_runs, x0_mean=[0.0], x0_cov=[[0.0]], x0_hat=[1.0], rng=3)
+    rec = mean_error_recursion(model, Kmat, x0_mean=[0.0], x0_hat=[1.0], n_steps=n_steps)
+    return mc, rec
+
+
+@register("estimateur-stabilite", chapter=CHAPTER, title="Stabilité : (I − KC) ne suffit pas, c'est (I − KC)A qui compte")
+def stability_figure():
+    fig, ax = new_figure(width=7.0, height=3.8)
+    colors = {0.4: "tab:red", 0.6: "tab:green"}
+    for K in COUNTER_GAINS:
+        mc, rec = stability_experiment(K)
+        n = np.arange(rec.e.shape[0])
+        rho_printed = abs(1 - K * COUNTER_EXAMPLE["C"])
+        rho = abs((1 - K * COUNTER_EXAMPLE["C"]) * COUNTER_EXAMPLE["A"])
+        label = rf"$K = {K:g}$ : $|1-KC| = {rho_printed:.1f}$, $|(1-KC)A| = {rho:.1f}$".replace(".", "{,}")
+        ax.semilogy(n, np.abs(rec.e[:, 0]), color=colors[K], lw=1.8, label=label)
+        ax.semilogy(n[1::2], np.abs(mc.mean_error()[1::2, 0]), "o", ms=3.5, color=colors[K], alpha=0.7)
+    ax.plot([], [], "o", ms=3.5, color="0.4", label="moyenne de Monte-Carlo (400 tirages)")
+    ax.set_xlabel("itération n (sans unité)")
+    ax.set_ylabel(r"$|\mathbb{E}[e_n]|$ (unités de x)")
+    ax.set_title(r"Contre-exemple $A = 2$, $C = 1$ : l'erreur moyenne est multipliée par $(1-KC)A$")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8, loc="upper left")
+    return fig

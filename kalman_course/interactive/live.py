@@ -1,0 +1,206 @@
+r"""Curseurs vivants (ipywidgets) : relancent le filtre du paquet à chaque relâchement de curseur.
+
+À utiliser dans Jupyter, sur Binder ou sur Colab (un noyau Python doit tourner). Les curseurs sont
+logarithmiques (``FloatLogSlider``) et affichent la vraie valeur du paramètre ; ``continuous_update``
+est désactivé : le calcul n'a lieu qu'au relâchement. La figure est une figure matplotlib du paquet
+(:func:`~kalman_course.figures.new_figure`, sans pyplot), rendue en PNG dans un widget ``Image``.
+
+Dans le livre publié (sans noyau), ces curseurs seraient morts : le livre montre à leur place la
+figure à curseurs statiques (:mod:`kalman_course.interactive.static`).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+import ipywidgets as widgets
+import numpy as np
+
+from ..figures import new_figure
+from ..validation import KalmanInputError, as_float_array
+from .spec import Panel, check_columns
+
+__all__ = ["LogParameter", "LiveExplorer"]
+
+#: Résolution du PNG affiché (pixels par pouce).
+LIVE_DPI = 100
+
+
+@dataclass(frozen=True)
+class LogParameter:
+    r"""Un curseur logarithmique : ``name`` (argument de ``run``), ``description`` (français), ``unit``,
+    valeur initiale ``value`` et bornes en décades ``min_exp``, ``max_exp`` (valeurs
+    :math:`10^{\min}` à :math:`10^{\max}`), pas ``step`` en décades."""
+
+    name: str
+    description: str
+    unit: str
+    value: float
+    min_exp: float
+    max_exp: float
+    step: float = 0.1
+
+    def __post_init__(self) -> None:
+        if not self.min_exp < self.max_exp:
+            raise KalmanInputError(
+                f"Curseur « {self.name} » : « min_exp » ({self.min_exp}) doit être < « max_exp » ({self.max_exp})."
+            )
+        v = float(self.value)
+        low, high = 10.0**self.min_exp, 10.0**self.max_exp
+        if not (math.isfinite(v) and low <= v <= high):
+            raise KalmanInputError(
+                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{low:.3g}, {high:.3g}] {self.unit}."
+            )
+
+    def slider(self) -> widgets.FloatLogSlider:
+        """Le ``FloatLogSlider`` : la valeur lue et affichée est la vraie valeur (pas son logarithme)."""
+        return widgets.FloatLogSlider(
+            value=float(self.value),
+            base=10.0,
+            min=self.min_exp,
+            max=self.max_exp,
+            step=self.step,
+            description=f"{self.description} ({self.unit})",
+            readout_format=".3g",
+            continuous_update=False,
+            style={"description_width": "14em"},
+            layout=widgets.Layout(width="36em"),
+        )
+
+
+class LiveExplorer:
+    """Curseurs ipywidgets + figure matplotlib redessinée par le filtre du paquet.
+
+    Paramètres
+    ----------
+    run : fonction ``run(**valeurs) -> dict nom → (T,)``
+        Relance le filtre pour les valeurs des curseurs (une clé par ``LogParameter.name``).
+    parameters : suite de LogParameter
+        Les curseurs, dans l'ordre d'affichage.
+    time : (T,)
+        Abscisse commune.
+    panels : suite de Panel
+        La figure (la même description que pour les curseurs statiques).
+    x_label : str
+        Libellé de l'abscisse, avec unité.
+    fixed : dict nom → (T,), optionnel
+        Séries indépendantes des curseurs (mesures).
+
+    Attributs utiles : ``sliders`` (dict nom → ``FloatLogSlider``), ``series`` (la dernière
+    exécution), ``lines`` (dict nom de série → liste de ``Line2D`` tracées), ``figure``, ``widget``.
+    """
+
+    def __init__(
+        self,
+        run: Callable[..., Mapping[str, np.ndarray]],
+        parameters,
+        time,
+        panels,
+        x_label: str,
+        fixed: Mapping[str, np.ndarray] | None = None,
+    ) -> None:
+        if not callable(run):
+            raise KalmanInputError(f"« run » doit être une fonction ; reçu {type(run).__name__}.")
+        self.parameters = tuple(parameters)
+        if not self.parameters or not all(isinstance(p, LogParameter) for p in self.parameters):
+            raise KalmanInputError("« parameters » doit être une suite non vide de LogParameter.")
+        self.panels = tuple(panels)
+        if not self.panels or not all(isinstance(p, Panel) for p in self.panels):
+            raise KalmanInputError("« panels » doit être une suite non vide de Panel.")
+        self.run = run
+        self.time = as_float_array("time", time)
+        self.fixed = {k: as_float_array(f"fixed[{k!r}]", v, allow_nan=True) for k, v in (fixed or {}).items()}
+        self.sliders = {p.name: p.slider() for p in self.parameters}
+        self.series = self._compute()
+        check_columns(self.panels, set(self.series) | set(self.fixed))
+        self.figure, self.lines, self._axes = self._draw(x_label)
+        self.image = widgets.Image(format="png", value=self._png())
+        for slider in self.sliders.values():
+            slider.observe(self._on_change, names="value")
+        self.widget = widgets.VBox([*self.sliders.values(), self.image])
+
+    # ------------------------------------------------------------------ calcul et dessin
+
+    def values(self) -> dict[str, float]:
+        """Les valeurs actuelles des curseurs (vraies valeurs, pas leurs logarithmes)."""
+        return {name: float(s.value) for name, s in self.sliders.items()}
+
+    def _compute(self) -> dict[str, np.ndarray]:
+        out = self.run(**self.values())
+        T = self.time.size
+        series = {}
+        for name, values in out.items():
+            if name == "t":
+                raise KalmanInputError("« run » ne doit pas renvoyer de série nommée « t » (réservé au temps).")
+            arr = np.asarray(values, dtype=float)
+            if arr.shape != (T,):
+                raise KalmanInputError(f"La série « {name} » doit avoir la forme ({T},) ; reçu {arr.shape}.")
+            series[name] = arr
+        return series
+
+    def _draw(self, x_label: str):
+        height = sum(p.height for p in self.panels) / 80.0
+        shared = not any(p.own_x for p in self.panels)
+        fig, axes = new_figure(len(self.panels), 1, width=7.0, height=height, sharex=shared, squeeze=False)
+        axes = axes[:, 0]
+        lines: dict[str, list] = {}
+        data = {"t": self.time, **self.fixed, **self.series}
+        for ax, panel in zip(axes, self.panels):
+            for glyph in panel.glyphs:
+                x = glyph.x
+                if glyph.kind == "hline":
+                    ax.axhline(glyph.value, color=glyph.color, lw=1.5, label=glyph.legend)
+                    continue
+                style = {"marker": "+", "ls": "none", "ms": 7} if glyph.kind == "scatter" else {"lw": 1.8}
+                (line,) = ax.plot(data[x], data[glyph.column], color=glyph.color, label=glyph.legend, **style)
+                line.kc_columns = (x, glyph.column)  # séries (abscisse, ordonnée) à relire au redessin
+                if glyph.column in self.series or x in self.series:
+                    lines.setdefault(glyph.column, []).append(line)
+            if panel.y_log:
+                ax.set_yscale("log")
+            if panel.y_range is not None:
+                ax.set_ylim(*panel.y_range)
+            if panel.x_range is not None:
+                ax.set_xlim(*panel.x_range)
+            if panel.equal_aspect:
+                ax.set_aspect("equal")
+            ax.set_title(panel.title, fontsize=10)
+            ax.set_ylabel(panel.y_label)
+            ax.set_xlabel(panel.x_label or x_label)
+            ax.grid(alpha=0.3, which="both" if panel.y_log else "major")
+            ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
+        return fig, lines, axes
+
+    def _png(self) -> bytes:
+        buffer = io.BytesIO()
+        self.figure.savefig(buffer, format="png", dpi=LIVE_DPI)
+        return buffer.getvalue()
+
+    def redraw(self) -> None:
+        """Relance le filtre avec les valeurs des curseurs et redessine les courbes."""
+        self.series = self._compute()
+        data = {"t": self.time, **self.fixed, **self.series}
+        for lines in self.lines.values():
+            for line in lines:
+                x, y = line.kc_columns
+                line.set_data(data[x], data[y])
+        for ax, panel in zip(self._axes, self.panels):
+            if panel.y_range is None:
+                ax.relim()
+                ax.autoscale_view(scalex=False)
+        self.image.value = self._png()
+
+    def _on_change(self, change) -> None:
+        self.redraw()
+
+    # ------------------------------------------------------------------ affichage Jupyter
+
+    def _repr_mimebundle_(self, **kwargs):
+        return self.widget._repr_mimebundle_(**kwargs)
+
+    def __repr__(self) -> str:
+        values = ", ".join(f"{k} = {v:.3g}" for k, v in self.values().items())
+        return f"<Curseurs vivants ({values}) : exige un noyau Jupyter en marche>"

@@ -1,0 +1,127 @@
+"""Extension Sphinx du livre : BokehJS servi par le site, boutons de lancement sans lien mort.
+
+À déclarer dans ``_config.yml`` (``sphinx: extra_extensions: [kalman_course.interactive.sphinx_ext]``).
+
+1. **BokehJS, une fois par page, seulement où il sert.** Les figures à curseurs statiques
+   (:mod:`.static`) ne contiennent pas BokehJS. Sur chaque page dont le corps contient une telle figure
+   (attribut :data:`~.static.MARKER`), l'extension ajoute à l'en-tête les scripts
+   ``_static/bokeh/bokeh-<version>.min.js`` et ``bokeh-widgets-<version>.min.js`` (une fois, même avec
+   plusieurs figures ; chemin relatif calculé par Sphinx, valable en ``http://`` et en ``file://``).
+   Au démarrage, elle vérifie que ces fichiers, copiés par ``scripts/vendor_assets.py`` dans un
+   dossier de ``html_static_path``, sont identiques à ceux du paquet Python ``bokeh`` installé.
+
+2. **Boutons de lancement (Binder, JupyterHub, Colab) sans lien mort.** Ils dépendent tous de
+   ``repository: url:`` dans ``_config.yml``, le seul réglage à renseigner. Tant qu'il est vide (ou
+   vaut l'URL par défaut de Jupyter Book, qui pointerait vers le projet jupyter-book lui-même), les
+   boutons de lancement sont retirés, mais le téléchargement du carnet exécuté (``.ipynb``) reste
+   proposé sur chaque chapitre. Colab n'ouvre que des ``.ipynb`` hébergés sur GitHub : sur une page
+   dont la source est un ``.md`` MyST sans ``.ipynb`` jumeau, le bouton Colab est retiré.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from sphinx.errors import ExtensionError
+from sphinx.util import logging
+
+from .static import BOKEH_VERSION, MARKER, bokehjs_files
+
+__all__ = ["setup", "installed_bokehjs", "JUPYTER_BOOK_DEFAULT_REPOSITORY"]
+
+LOGGER = logging.getLogger(__name__)
+
+#: URL mise par Jupyter Book 1 quand ``repository: url:`` n'est pas donné.
+JUPYTER_BOOK_DEFAULT_REPOSITORY = "https://github.com/executablebooks/jupyter-book"
+#: Clés de ``launch_buttons`` qui créent un bouton pointant vers le dépôt.
+LAUNCH_PROVIDERS = ("binderhub_url", "jupyterhub_url", "colab_url", "deepnote_url", "jupyterlite_url", "thebe")
+
+
+def installed_bokehjs() -> dict[str, Path]:
+    """Fichiers BokehJS du paquet Python ``bokeh`` installé : nom servi → chemin source."""
+    from bokeh.util.paths import bokehjs_path
+
+    js = Path(bokehjs_path()) / "js"
+    sources = [js / "bokeh.min.js", js / "bokeh-widgets.min.js"]
+    return dict(zip(bokehjs_files(), sources))
+
+
+def _check_bokehjs(app) -> None:
+    if app.builder.format != "html":
+        return
+    static_dirs = [Path(app.confdir, p) for p in app.config.html_static_path]
+    for served, source in installed_bokehjs().items():
+        candidates = [d / served for d in static_dirs if (d / served).is_file()]
+        if not candidates:
+            raise ExtensionError(
+                f"BokehJS {BOKEH_VERSION} introuvable : « {served} » n'est dans aucun dossier de "
+                f"html_static_path ({', '.join(map(str, app.config.html_static_path))}). "
+                "Lancez « python scripts/vendor_assets.py »."
+            )
+        if candidates[0].read_bytes() != source.read_bytes():
+            raise ExtensionError(
+                f"« {candidates[0]} » diffère du BokehJS du paquet bokeh {BOKEH_VERSION} installé : "
+                "relancez « python scripts/vendor_assets.py »."
+            )
+
+
+def _add_bokehjs(app, pagename, templatename, context, doctree) -> None:
+    if MARKER in context.get("body", ""):
+        for served in bokehjs_files():
+            app.add_js_file(served)
+
+
+def _guard_launch_buttons(app, config) -> None:
+    options = config.html_theme_options
+    launch = dict(options.get("launch_buttons") or {})
+    url = str(options.get("repository_url", "") or "").strip().rstrip("/")
+    if url and url != JUPYTER_BOOK_DEFAULT_REPOSITORY:
+        return
+    if any(launch.get(key) for key in LAUNCH_PROVIDERS):
+        LOGGER.info(
+            "[kalman_course] « repository: url: » n'est pas renseigné dans _config.yml : boutons de "
+            "lancement (Binder, JupyterHub, Colab) désactivés, téléchargement .ipynb conservé."
+        )
+    options["launch_buttons"] = {k: v for k, v in launch.items() if k not in LAUNCH_PROVIDERS}
+    config.kc_ipynb_download = True
+
+
+def _ipynb_download(app, pagename, templatename, context, doctree) -> None:
+    """Sans bouton de lancement, le thème ne copie pas le carnet exécuté : on le fait ici (même
+    emplacement que le thème : ``_sources/<page>.ipynb``) pour garder le bouton « .ipynb »."""
+    if not app.config.kc_ipynb_download:
+        return
+    if "kernelspec" not in app.env.metadata.get(pagename, {}):
+        return
+    source = Path(app.outdir).parent / "jupyter_execute" / f"{pagename}.ipynb"
+    if not source.is_file():
+        return
+    target = Path(app.outdir) / "_sources" / f"{pagename}.ipynb"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    shutil.copy2(source, target)
+    context["ipynb_source"] = f"{pagename}.ipynb"
+
+
+def _drop_colab_for_markdown(app, pagename, templatename, context, doctree) -> None:
+    source = Path(app.env.doc2path(pagename))
+    if source.suffix == ".ipynb" or source.with_suffix(".ipynb").exists():
+        return
+    for group in context.get("header_buttons", []):
+        if group.get("label") == "launch-buttons":
+            group["buttons"] = [b for b in group["buttons"] if b.get("text") != "Colab"]
+    context["header_buttons"] = [
+        g for g in context.get("header_buttons", []) if g.get("label") != "launch-buttons" or g["buttons"]
+    ]
+
+
+def setup(app):
+    app.add_config_value("kc_ipynb_download", False, "html", types=[bool])
+    app.connect("config-inited", _guard_launch_buttons, priority=900)
+    app.connect("builder-inited", _check_bokehjs)
+    app.connect("html-page-context", _add_bokehjs)
+    # le thème construit ses boutons à la priorité 501 : le carnet doit être copié avant (500),
+    # le bouton Colab retiré après (502)
+    app.connect("html-page-context", _ipynb_download, priority=500)
+    app.connect("html-page-context", _drop_colab_for_markdown, priority=502)
+    return {"version": BOKEH_VERSION, "parallel_read_safe": True, "parallel_write_safe": True}

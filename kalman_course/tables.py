@@ -1,0 +1,94 @@
+"""Petits tableaux de résultats affichés dans le livre (Markdown rendu par Jupyter / MyST-NB), sans pandas."""
+
+from __future__ import annotations
+
+import html
+import re
+from typing import Any, Sequence
+
+import numpy as np
+
+from .validation import KalmanInputError
+
+__all__ = ["Table"]
+
+
+def _html_cell(text: str) -> str:
+    """Échappe le HTML hors des formules ; ``$…$`` devient ``\\(…\\)``."""
+    parts = re.split(r"\$([^$]+)\$", text)
+    out = []
+    for i, part in enumerate(parts):
+        out.append(f"\\({html.escape(part, quote=False)}\\)" if i % 2 else html.escape(part, quote=False))
+    return "".join(out)
+
+
+class Table:
+    r"""Tableau de colonnes numériques (ou textuelles), formaté colonne par colonne.
+
+    ``headers`` : en-têtes (Markdown, formules :math:`\LaTeX` permises) ; ``columns`` : une séquence de
+    valeurs par colonne, toutes de même longueur ; ``formats`` : un format ``str.format`` par colonne
+    (``"{:.4g}"``…), ``None`` pour ``str``. S'affiche en HTML dans un carnet et dans le livre
+    (``_repr_html_``, formules pour MathJax) ; ``str(table)`` donne le Markdown.
+    """
+
+    def __init__(
+        self,
+        headers: Sequence[str],
+        columns: Sequence[Sequence[Any]],
+        formats: Sequence[str | None] | None = None,
+    ) -> None:
+        if len(headers) != len(columns):
+            raise KalmanInputError(
+                f"« headers » ({len(headers)}) et « columns » ({len(columns)}) doivent avoir la même longueur."
+            )
+        lengths = {len(c) for c in columns}
+        if len(lengths) > 1:
+            raise KalmanInputError(f"Les colonnes doivent avoir la même longueur ; reçu {sorted(lengths)}.")
+        formats = [None] * len(headers) if formats is None else list(formats)
+        if len(formats) != len(headers):
+            raise KalmanInputError("« formats » doit donner un format par colonne.")
+        self.headers = list(headers)
+        self.columns = [list(np.asarray(c).tolist()) if isinstance(c, np.ndarray) else list(c) for c in columns]
+        self.formats = formats
+
+    @property
+    def n_rows(self) -> int:
+        """Nombre de lignes."""
+        return len(self.columns[0]) if self.columns else 0
+
+    def cell(self, row: int, col: int) -> str:
+        """Texte de la case (ligne ``row``, colonne ``col``)."""
+        value = self.columns[col][row]
+        fmt = self.formats[col]
+        return str(value) if fmt is None else fmt.format(value)
+
+    def to_markdown(self) -> str:
+        """Le tableau en Markdown (tableau à barres verticales)."""
+        lines = [
+            "| " + " | ".join(self.headers) + " |",
+            "|" + "|".join("---:" for _ in self.headers) + "|",
+        ]
+        for r in range(self.n_rows):
+            lines.append("| " + " | ".join(self.cell(r, c) for c in range(len(self.headers))) + " |")
+        return "\n".join(lines)
+
+    def to_html(self) -> str:
+        r"""Le tableau en HTML (les formules ``$…$`` deviennent ``\(…\)`` pour MathJax)."""
+        head = "".join(f"<th>{_html_cell(h)}</th>" for h in self.headers)
+        rows = "".join(
+            "<tr>" + "".join(f"<td>{_html_cell(self.cell(r, c))}</td>" for c in range(len(self.headers))) + "</tr>"
+            for r in range(self.n_rows)
+        )
+        return f'<table class="table kc-table"><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>'
+
+    def _repr_html_(self) -> str:
+        return self.to_html()
+
+    def _repr_markdown_(self) -> str:
+        return self.to_markdown()
+
+    def __str__(self) -> str:
+        return self.to_markdown()
+
+    def __repr__(self) -> str:
+        return self.to_markdown()

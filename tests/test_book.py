@@ -1,0 +1,156 @@
+"""Le livre : construction propre (-W, aucune alerte, aucune cellule en erreur) et contenu des pages.
+
+Les tests statiques (sans construction) vérifient que les chapitres ne contiennent pas de code de
+tracé et n'appellent que des figures enregistrées. Les autres utilisent la fixture ``built_book`` de
+``conftest.py`` (une construction complète par session ; ``KALMAN_BOOK_BUILD_DIR`` choisit le dossier).
+"""
+
+from __future__ import annotations
+
+import html as htmllib
+import re
+from pathlib import Path
+
+import pytest
+import yaml
+
+import kalman_course as kc
+
+ROOT = Path(__file__).resolve().parent.parent
+BOOK = ROOT / "book"
+
+# Chapitres de la partie « Le filtre de Kalman linéaire », dans l'ordre du cours, et page des références.
+LINEAR_CHAPTERS = [
+    "controle-systeme", "estimateur", "predicteur-correcteur", "gain-optimal", "tension-constante",
+    "pratique-synthese",
+]
+# Seul bruit toléré dans le journal : l'avertissement d'ipykernel sur le transport TCP local des noyaux
+# (TOOLCHAIN.md : « Console noise that is not an error »).
+TOLERATED = re.compile(r"\[IPKernelApp\] WARNING \| Kernel is running over TCP without encryption")
+
+
+def _toc_files() -> list[str]:
+    toc = yaml.safe_load((ROOT / "_toc.yml").read_text())
+    files = [toc["root"]]
+    for part in toc.get("parts", []):
+        files += [chapter["file"] for chapter in part["chapters"]]
+    return files
+
+
+def _code_cells(text: str) -> list[str]:
+    return re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, flags=re.S)
+
+
+# --------------------------------------------------------------------------- sans construction
+
+
+def test_toc_has_the_lecture_order_and_references_last():
+    files = _toc_files()
+    linear = [f for f in files if Path(f).name in LINEAR_CHAPTERS]
+    assert linear == [f"book/{name}" for name in LINEAR_CHAPTERS]
+    assert files[-1] == "book/references"
+
+
+@pytest.mark.parametrize("chapter", LINEAR_CHAPTERS)
+def test_chapters_hold_no_plotting_code_and_draw_registered_figures(chapter):
+    text = (BOOK / f"{chapter}.md").read_text()
+    code = "\n".join(_code_cells(text))
+    for forbidden in ("matplotlib", "pyplot", ".plot(", ".scatter(", ".hist(", "savefig", "set_xlabel"):
+        assert forbidden not in code, f"{chapter} : code de tracé « {forbidden} » dans une cellule"
+    drawn = re.findall(r"kc\.figures\.draw\(\"([^\"]+)\"\)", code)
+    assert drawn, f"{chapter} : aucune figure"
+    for name in drawn:
+        assert name in kc.figures.REGISTRY, f"{chapter} : figure inconnue {name}"
+    own = [n for n, spec in kc.figures.REGISTRY.items() if spec.chapter == chapter]
+    assert sorted(set(drawn)) == sorted(own), f"{chapter} : figures du registre non montrées"
+
+
+@pytest.mark.parametrize("chapter", LINEAR_CHAPTERS)
+def test_each_chapter_has_an_exercise_with_a_hidden_computed_solution(chapter):
+    text = (BOOK / f"{chapter}.md").read_text()
+    labels = re.findall(r"```\{exercise\}\n:label: (\S+)", text)
+    assert labels, f"{chapter} : aucun exercice"
+    for label in labels:
+        block = re.search(r"```\{solution-start\} " + re.escape(label) + r"\n(.*?)```\{solution-end\}", text, re.S)
+        assert block, f"{chapter} : pas de solution pour {label}"
+        assert ":class: dropdown" in block.group(1)
+        assert "kc." in "".join(_code_cells(block.group(1) + "```")), f"{label} : la solution n'appelle pas le paquet"
+
+
+# --------------------------------------------------------------------------- construction
+
+
+@pytest.mark.book
+def test_build_log_has_no_warning(built_book):
+    log = (built_book.parent / "build.log").read_text()
+    warnings = [line for line in log.splitlines() if "WARNING" in line and not TOLERATED.search(line)]
+    assert not warnings, "\n".join(warnings)
+    assert "build succeeded" in log
+
+
+@pytest.mark.book
+def test_every_toc_page_exists(built_book):
+    for docname in _toc_files():
+        assert (built_book / f"{docname}.html").is_file(), docname
+
+
+@pytest.mark.book
+def test_no_cell_output_is_an_error(built_book):
+    for page in built_book.rglob("*.html"):
+        html = page.read_text(errors="replace")
+        for marker in ('class="output stderr', 'class="output traceback', 'class="output error',
+                       "Traceback (most recent call last)"):
+            assert marker not in html, f"{page.name} : sortie d'erreur « {marker} »"
+
+
+@pytest.mark.book
+@pytest.mark.parametrize("chapter", LINEAR_CHAPTERS)
+def test_chapter_pages_show_math_figures_and_glued_numbers(built_book, chapter):
+    html = (built_book / "book" / f"{chapter}.html").read_text()
+    text = (BOOK / f"{chapter}.md").read_text()
+    assert 'class="math' in html
+    n_draws = len(re.findall(r"kc\.figures\.draw\(", "\n".join(_code_cells(text))))
+    images = re.findall(r'<img alt="[^"]*" src="(\.\./_images/[0-9a-f]+\.png)"', html)
+    assert len(images) >= n_draws
+    for src in images:
+        assert (built_book / "book" / src).resolve().is_file()
+    n_glue = len(re.findall(r"\{glue:text\}", text))
+    assert html.count('class="pasted-text"') >= n_glue  # chaque nombre cité vient d'une cellule
+    assert "???" not in re.sub(r"<[^>]+>", "", html)
+    assert html.count('class="solution dropdown') >= 1
+
+
+@pytest.mark.book
+def test_mermaid_diagrams_are_build_time_svg(built_book):
+    html = (built_book / "book" / "predicteur-correcteur.html").read_text()
+    svgs = re.findall(r'<object data="(\.\./_images/mermaid-[0-9a-f]+\.svg)" type="image/svg\+xml">', html)
+    assert len(svgs) == 3
+    texts = [(built_book / "book" / s).resolve().read_text() for s in svgs]
+    assert any("Kₙ₊₁" in t for t in texts)  # la boucle, indices lisibles
+    assert any("K → C⁻¹" in t for t in texts)  # schéma du gain corrigé (erratum 001-4)
+    assert not any("K → I" in t for t in texts)
+    assert "mermaid.esm" not in html and "cdn.jsdelivr" not in html  # pas de JavaScript mermaid distant
+
+
+@pytest.mark.book
+def test_references_page_has_the_thirty_lecture_references(built_book):
+    html = (built_book / "book" / "references.html").read_text()
+    for needle in ("10.1115/1.3662552", "10.1109/78.978374", "10.1109/MSP.2012.2203621",
+                   "kalman_intro.pdf", "poly_Kalman_Herscovici.pdf", "gilleschardon.fr/fc/kalman/kalman.pdf",
+                   "Kalman-and-Bayesian-Filters-in-Python", "wiki.ros.org/robot_localization",
+                   "cup_book_online_20131111.pdf", "978-0262018029", "978-0471708582"):
+        assert needle in html, needle
+    bib = (BOOK / "references.bib").read_text()
+    entries = re.split(r"(?m)^@", bib)[1:]
+    lecture = [e for e in entries if re.search(r"keywords\s*=\s*\{cours-", e)]
+    assert len(lecture) == 30
+    assert html.count('role="doc-biblioentry"') >= 30
+    page_text = " ".join(htmllib.unescape(re.sub(r"<[^>]+>", " ", html)).split()).lower()
+    for entry in lecture:
+        title = re.search(r"\btitle\s*=\s*\{(.*)\},?\n", entry).group(1)
+        clean = title.replace("{", "").replace("}", "").replace("\\_", "_")
+        start = " ".join(clean.split()[:3]).lower()
+        assert start in page_text, start
+    # les chapitres citent la page des références
+    intro = (built_book / "book" / "intro.html").read_text()
+    assert "references.html#" in intro

@@ -1,0 +1,359 @@
+"""Le site construit dans Chromium headless (Debian, /usr/bin/chromium), sans réseau.
+
+Le site est servi sur 127.0.0.1 (port libre) ; toute requête non locale est interceptée, bloquée et
+fait échouer le test. Pour chaque page : aucune erreur de page, formules typographiées par MathJax
+(servi par le site), diagrammes mermaid dessinés. Sur les pages à curseurs statiques : les curseurs
+sont déplacés par de vrais événements clavier et souris, et les données tracées, relues dans le
+document Bokeh, sont comparées aux exécutions calculées ici par le paquet.
+"""
+
+from __future__ import annotations
+
+import functools
+import http.server
+import re
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+from urllib.parse import urlsplit
+
+import numpy as np
+import playwright.sync_api as playwright_api
+import pytest
+
+import kalman_course.interactive as ki
+from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
+
+pytestmark = pytest.mark.browser
+
+ROOT = Path(__file__).resolve().parent.parent
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = [
+    "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+]
+# La seule erreur de page tolérée : sphinx-thebe 0.3.1 (extension chargée d'office par Jupyter Book 1)
+# ajoute son script de configuration en ligne « const THEBE_JS_URL = … » à chaque événement
+# env-before-read-docs ; la page en contient alors deux copies et la seconde déclaration échoue.
+# Ce n'est pas notre code et cela ne casse rien (thebe est désactivé) : on ne la tolère que si la page
+# contient réellement les deux déclarations.
+THEBE_ERROR = "Identifier 'THEBE_JS_URL' has already been declared"
+
+#: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet).
+EXPECTED_GRIDS = {"tension-curseurs": ki.voltage_grid, "tag-curseurs": ki.tag_grid}
+
+
+class _QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args):  # pas de journal d'accès dans la sortie des tests
+        pass
+
+
+@dataclass
+class Site:
+    root: Path
+    base: str
+
+    def url(self, path: Path) -> str:
+        return self.base + path.relative_to(self.root).as_posix()
+
+    def file_for(self, url: str) -> Path:
+        return self.root / urlsplit(url).path.lstrip("/")
+
+
+@pytest.fixture(scope="module")
+def site(built_book):
+    handler = functools.partial(_QuietHandler, directory=str(built_book))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield Site(built_book, f"http://127.0.0.1:{server.server_address[1]}/")
+    server.shutdown()
+    server.server_close()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    if not Path(CHROMIUM).exists():
+        pytest.fail(f"{CHROMIUM} absent : installez le paquet Debian « chromium » (scripts/setup.sh le fait).")
+    with playwright_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+@dataclass
+class Visit:
+    page: object
+    blocked: list[str] = field(default_factory=list)
+    errors: list[str] = field(default_factory=list)
+    broken: list[str] = field(default_factory=list)
+    loaded: list[str] = field(default_factory=list)
+
+
+def open_page(browser, url: str, allowed_prefix: str) -> Visit:
+    """Ouvre ``url`` en bloquant (et notant) toute requête qui ne commence pas par ``allowed_prefix``."""
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    page = context.new_page()
+    visit = Visit(page)
+
+    def route(r):
+        u = r.request.url
+        if u.startswith(allowed_prefix) or u.startswith(("data:", "blob:")):
+            r.continue_()
+        else:
+            visit.blocked.append(u)
+            r.abort()
+
+    context.route("**/*", route)
+    page.on("pageerror", lambda e: visit.errors.append(str(e)))
+    page.on("response", lambda r: (visit.broken if r.status >= 400 else visit.loaded).append(r.url))
+    page.on("requestfailed", lambda r: None if r.url in visit.blocked else visit.broken.append(r.url))
+    page.goto(url, wait_until="load")
+    # MathJax (chargé en « defer ») : attendre la fin de la composition initiale
+    page.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise.then(() => true) : true")
+    n_fig = page.locator(f"[{MARKER}]").count()
+    if n_fig:
+        page.wait_for_function(
+            """(n) => window.Bokeh && Bokeh.documents.length >= n &&
+                 [...document.querySelectorAll('.kc-bokeh-root')].every(r => r.children.length > 0 &&
+                     !r.querySelector('.kc-bokeh-missing'))""",
+            arg=n_fig, timeout=15000,
+        )
+        page.locator(f"[{MARKER}] .noUi-handle").first.wait_for(timeout=15000)
+    return visit
+
+
+def html_pages(root: Path) -> list[Path]:
+    skip = {"_static", "_sources", "_images", "_downloads"}
+    return sorted(p for p in root.rglob("*.html") if not skip & set(p.relative_to(root).parts))
+
+
+def tolerated_errors(visit: Visit, html: str) -> list[str]:
+    n_thebe = html.count("const THEBE_JS_URL")
+    return [e for e in visit.errors if not (THEBE_ERROR in e and n_thebe >= 2)]
+
+
+_RAW_TEX = r"""() => {
+  const skip = 'pre, code, script, style, mjx-container, noscript, textarea, .highlight';
+  const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+  const found = [];
+  for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+    if (n.parentElement && n.parentElement.closest(skip)) continue;
+    const t = n.textContent;
+    if (/\$\$|\\\(|\\\)|\\\[|\\\]|\\frac|\\begin\{/.test(t)) found.push(t.trim().slice(0, 80));
+  }
+  return found;
+}"""
+
+_MATH = """() => [...document.querySelectorAll('.math')].map(el => !!el.querySelector('mjx-container'))"""
+
+_MERMAID = """() => [...document.querySelectorAll(
+    'object[data*="mermaid"], img[src*="mermaid"], pre.mermaid, div.mermaid')].map(el => {
+  const box = el.getBoundingClientRect();
+  let svg = null;
+  if (el.tagName === 'OBJECT') svg = el.contentDocument && el.contentDocument.querySelector('svg');
+  else if (el.tagName === 'IMG') return {kind: 'img', w: box.width, h: box.height, ok: el.naturalWidth > 0};
+  else svg = el.querySelector('svg');
+  const sb = svg ? svg.getBoundingClientRect() : {width: 0, height: 0};
+  const labels = svg ? svg.querySelectorAll('text, foreignObject').length : 0;
+  return {kind: el.tagName.toLowerCase(), w: box.width, h: box.height, ok: !!svg && sb.width > 0 &&
+          sb.height > 0 && labels > 0};
+})"""
+
+
+def _mermaid_sources(html_file: Path, root: Path) -> int:
+    source = ROOT / html_file.relative_to(root).with_suffix(".md")
+    if not source.is_file():
+        return 0
+    return len(re.findall(r"^(?:```|:::)\{mermaid\}", source.read_text(), re.M))
+
+
+def test_every_page_is_offline_typeset_and_drawn(site, browser):
+    pages = html_pages(site.root)
+    assert any(p.name == "tension-constante.html" for p in pages)
+    problems: list[str] = []
+    for html_file in pages:
+        html = html_file.read_text()
+        name = html_file.relative_to(site.root).as_posix()
+        redirect = re.search(r'http-equiv="refresh" content="0; url=([^"]+)"', html, re.I)
+        if redirect:  # page de redirection (index.html → première page) : la cible doit exister
+            if not (html_file.parent / redirect[1]).is_file():
+                problems.append(f"{name} : redirection vers {redirect[1]} introuvable")
+            continue
+        visit = open_page(browser, site.url(html_file), site.base)
+        page = visit.page
+        if visit.blocked:
+            problems.append(f"{name} : requêtes non locales {visit.blocked}")
+        if visit.broken:
+            problems.append(f"{name} : ressources locales manquantes {visit.broken}")
+        for err in tolerated_errors(visit, html):
+            problems.append(f"{name} : erreur de page {err}")
+        typeset = page.evaluate(_MATH)
+        if not all(typeset):
+            problems.append(f"{name} : {typeset.count(False)} formule(s) sur {len(typeset)} non composées")
+        if '<span class="math' in html or '<div class="math' in html:
+            if page.locator("mjx-container").count() == 0:
+                problems.append(f"{name} : aucune sortie MathJax")
+        raw = page.evaluate(_RAW_TEX)
+        if raw:
+            problems.append(f"{name} : TeX brut visible {raw[:3]}")
+        if page.locator(".mermaid, object[data*='mermaid'], img[src*='mermaid']").count():
+            try:  # attendre le chargement des SVG ; un échec est signalé plus bas, diagramme par diagramme
+                page.wait_for_function(
+                    "() => [...document.querySelectorAll('object[data*=\"mermaid\"]')].every(o => "
+                    "o.contentDocument && o.contentDocument.querySelector('svg'))", timeout=10000)
+            except playwright_api.TimeoutError:
+                pass
+        diagrams = page.evaluate(_MERMAID)
+        bad = [d for d in diagrams if not (d["ok"] and d["w"] > 0 and d["h"] > 0)]
+        if bad:
+            problems.append(f"{name} : diagramme(s) mermaid non dessiné(s) {bad}")
+        expected = _mermaid_sources(html_file, site.root)
+        if len(diagrams) != expected:
+            problems.append(f"{name} : {len(diagrams)} diagramme(s) affiché(s), {expected} dans la source")
+        # aucun curseur ipywidgets (il serait mort sans noyau), aucun lien vers le projet jupyter-book
+        if page.locator(".jupyter-widgets, script[type='application/vnd.jupyter.widget-state+json']").count():
+            problems.append(f"{name} : widget ipywidgets dans la page publiée")
+        if page.locator("a[href*='executablebooks']").count():
+            problems.append(f"{name} : lien vers le projet jupyter-book")
+        page.context.close()
+    assert not problems, "\n".join(problems)
+
+
+# --------------------------------------------------------------------------- curseurs statiques
+
+_READ = """(k) => {
+  const doc = Bokeh.documents[k];
+  const src = doc.get_model_by_name('%s');
+  const out = {};
+  for (const name of Object.keys(src.data)) out[name] = Array.from(src.data[name]);
+  return {i: doc.get_model_by_name('kc-slider-0').value, j: doc.get_model_by_name('kc-slider-1').value, data: out};
+}""" % PLOTTED_SOURCE
+
+
+def _check_plotted(page, k: int, grid, root) -> tuple[int, int]:
+    state = page.evaluate(_READ, k)
+    i, j = state["i"], state["j"]
+    assert float(i).is_integer() and float(j).is_integer()
+    i, j = int(i), int(j)
+    expected = grid.run(i, j)
+    for name, values in expected.items():
+        np.testing.assert_allclose(np.array(state["data"][name], dtype=float), values, rtol=1e-12, atol=0,
+                                   err_msg=f"série {name}, point ({i}, {j})")
+    np.testing.assert_array_equal(state["data"]["t"], grid.time)
+    # les curseurs affichent les vraies valeurs du point de grille
+    shown = [root.locator(".bk-slider-value").nth(s).text_content() for s in (0, 1)]
+    assert shown == [grid.axes[0].labels()[i], grid.axes[1].labels()[j]]
+    return i, j
+
+
+def _drag(page, handle, base, fraction: float) -> None:
+    hb, bb = handle.bounding_box(), base.bounding_box()
+    y = hb["y"] + hb["height"] / 2
+    page.mouse.move(hb["x"] + hb["width"] / 2, y)
+    page.mouse.down()
+    page.mouse.move(bb["x"] + fraction * bb["width"], y, steps=8)
+    page.mouse.up()
+
+
+def _weight(visit: Visit, site: Site, html_file: Path) -> dict[str, int]:
+    """Octets de la page, par catégorie (tailles des fichiers servis). Les images sont comptées
+    d'après le HTML (chargement différé possible), les scripts et feuilles d'après les réponses."""
+    html = html_file.read_text()
+    images = {(html_file.parent / src).resolve() for src in re.findall(r'<img[^>]+src="([^"]+)"', html)}
+    sizes = {"page HTML (données incluses)": html_file.stat().st_size,
+             "images du chapitre": sum(f.stat().st_size for f in images if f.is_file()),
+             "BokehJS (partagé)": 0, "MathJax (partagé)": 0, "thème et autres scripts (partagés)": 0}
+    for url in dict.fromkeys(visit.loaded):
+        f = site.file_for(url).resolve()
+        if not f.is_file() or f == html_file.resolve() or f in images:
+            continue
+        rel = f.relative_to(site.root.resolve()).as_posix()
+        if rel.startswith("_static/bokeh/"):
+            sizes["BokehJS (partagé)"] += f.stat().st_size
+        elif rel.startswith("_static/mathjax/"):
+            sizes["MathJax (partagé)"] += f.stat().st_size
+        elif not rel.startswith("_images/"):
+            sizes["thème et autres scripts (partagés)"] += f.stat().st_size
+    return sizes
+
+
+def test_static_sliders_show_the_package_runs(site, browser, capsys):
+    pages = [p for p in html_pages(site.root) if MARKER in p.read_text()]
+    names = [p.relative_to(site.root).as_posix() for p in pages]
+    assert "book/tension-constante.html" in names, "le chapitre « tension constante » n'a plus ses curseurs"
+    for html_file in pages:
+        visit = open_page(browser, site.url(html_file), site.base)
+        page = visit.page
+        figures = page.locator(f"[{MARKER}]")
+        for k in range(figures.count()):
+            fig_name = figures.nth(k).get_attribute(MARKER)
+            assert fig_name in EXPECTED_GRIDS, f"figure « {fig_name} » inconnue du test : ajoutez sa grille"
+            grid = EXPECTED_GRIDS[fig_name]()
+            root = figures.nth(k)
+            # position par défaut = la figure statique du chapitre
+            assert _check_plotted(page, k, grid, root) == grid.default_index
+            for s in (0, 1):
+                handle = root.locator(".noUi-handle").nth(s)
+                base = root.locator(".noUi-base").nth(s)
+                n = grid.shape[s]
+                seen = set()
+                handle.focus()
+                page.keyboard.press("End")
+                pos = _check_plotted(page, k, grid, root)
+                assert pos[s] == n - 1
+                seen.add(pos)
+                page.keyboard.press("Home")
+                pos = _check_plotted(page, k, grid, root)
+                assert pos[s] == 0
+                for _ in range(3):
+                    page.keyboard.press("ArrowRight")
+                pos = _check_plotted(page, k, grid, root)
+                assert pos[s] == 3
+                _drag(page, handle, base, 0.8)
+                pos = _check_plotted(page, k, grid, root)
+                assert abs(pos[s] - 0.8 * (n - 1)) <= 1
+                page.mouse.click(*_point(base, 0.1))  # clic sur la glissière
+                pos = _check_plotted(page, k, grid, root)
+                assert abs(pos[s] - 0.1 * (n - 1)) <= 1
+                # retour à la position par défaut, au clavier
+                handle.focus()
+                page.keyboard.press("Home")
+                for _ in range(grid.default_index[s]):
+                    page.keyboard.press("ArrowRight")
+                assert _check_plotted(page, k, grid, root)[s] == grid.default_index[s]
+        assert not visit.blocked and not visit.broken
+        assert not tolerated_errors(visit, html_file.read_text()), visit.errors
+        sizes = _weight(visit, site, html_file)
+        own = sizes["page HTML (données incluses)"] + sizes["images du chapitre"]
+        shared = sum(sizes.values()) - own
+        with capsys.disabled():
+            print(f"\nPoids de {html_file.relative_to(site.root)} :")
+            for label, size in sizes.items():
+                print(f"  {label:38s} {size / 1e6:7.3f} Mo")
+            print(f"  {'propre au chapitre (HTML + données + images)':38s} {own / 1e6:7.3f} Mo")
+            print(f"  {'partagé par le site':38s} {shared / 1e6:7.3f} Mo")
+        page.context.close()
+
+
+def _point(locator, fraction: float) -> tuple[float, float]:
+    b = locator.bounding_box()
+    return b["x"] + fraction * b["width"], b["y"] + b["height"] / 2
+
+
+def test_interactive_chapter_works_from_file_url(site, browser):
+    """Le site téléchargé s'ouvre aussi sans serveur (file://) : BokehJS, MathJax et données suivent."""
+    html_file = site.root / "book" / "tension-constante.html"
+    visit = open_page(browser, html_file.as_uri(), "file://")
+    page = visit.page
+    assert not visit.blocked, visit.blocked
+    assert page.locator("mjx-container").count() > 0
+    grid = ki.voltage_grid()
+    root = page.locator(f"[{MARKER}='tension-curseurs']")
+    assert _check_plotted(page, 0, grid, root) == grid.default_index
+    root.locator(".noUi-handle").nth(1).focus()
+    page.keyboard.press("PageUp")
+    i, j = _check_plotted(page, 0, grid, root)
+    assert (i, j) != grid.default_index
+    assert not tolerated_errors(visit, html_file.read_text()), visit.errors
+    page.context.close()
