@@ -24,7 +24,7 @@ import scipy.linalg
 
 from .kf import Prediction, Update, _check_state, _correct, _symmetrize
 from .models import NonlinearModel
-from .results import FilterResult
+from .results import FilterHistory, FilterResult
 from .validation import KalmanInputError, as_controls, as_measurements, as_vector, check_control_allowed
 
 __all__ = [
@@ -262,34 +262,21 @@ def _run(model, y, x0, P0, u, correct) -> FilterResult:
     U = as_controls("u", u, T, model.n_control)
     x, P = _check_state(x0, P0, n, "x0", "P0")
     observed = ~np.isnan(Y)
-
-    xs = np.empty((T, n))
-    Ps = np.empty((T, n, n))
-    xps = np.empty((T, n))
-    Pps = np.empty((T, n, n))
-    Ks = np.zeros((T, n, m))
-    nus = np.full((T, m), np.nan)
-    Ss = np.full((T, m, m), np.nan)
-    n_iter = np.zeros(T, dtype=int)
+    out = FilterHistory(T, n, m, observed, iterated=True)
 
     for k in range(T):
         x_pred, P_pred = _predict(model, x, P, None if U is None else U[k])
-        xps[k] = x_pred
-        Pps[k] = P_pred
         if observed[k].any():
             idx = None if observed[k].all() else np.flatnonzero(observed[k])
-            x, P, K, nu, S, n_iter[k] = correct(model, x_pred, P_pred, Y[k], idx)
-            cols = slice(None) if idx is None else idx
-            Ks[k][:, cols] = K
-            nus[k, cols] = nu
-            Ss[k][np.ix_(np.arange(m)[cols], np.arange(m)[cols])] = S
+            x, P, K, nu, S, out.n_iter[k] = correct(model, x_pred, P_pred, Y[k], idx)
+            out.correction(k, K, nu, S, idx)
         else:
             x, P = x_pred, P_pred
-        xs[k] = x
-        Ps[k] = P
-    return FilterResult(
-        x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss, observed=observed, n_iter=n_iter
-    )
+        out.x_pred[k] = x_pred
+        out.P_pred[k] = P_pred
+        out.x[k] = x
+        out.P[k] = P
+    return out.result()
 
 
 def extended_kalman_filter(

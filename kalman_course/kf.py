@@ -15,7 +15,7 @@ import numpy as np
 import scipy.linalg
 
 from .models import LinearGaussianModel
-from .results import FilterResult
+from .results import FilterHistory, FilterResult
 from .validation import (
     KalmanInputError,
     as_controls,
@@ -238,38 +238,24 @@ def kalman_filter(
     BU = None if U is None else U @ model.B.T  # (T, n)
     observed = ~np.isnan(Y)
     all_observed = bool(observed.all())
-
-    xs = np.empty((T, n))
-    Ps = np.empty((T, n, n))
-    xps = np.empty((T, n))
-    Pps = np.empty((T, n, n))
-    Ks = np.zeros((T, n, m))
-    nus = np.full((T, m), np.nan)
-    Ss = np.full((T, m, m), np.nan)
+    out = FilterHistory(T, n, m, observed)
 
     for k in range(T):
         x_pred, P_pred = _predict(x, P, A, Q, None if BU is None else BU[k])
-        xps[k] = x_pred
-        Pps[k] = P_pred
         if all_observed or observed[k].all():
             nu = Y[k] - C.dot(x_pred)
             x, P, K, S = _correct(x_pred, P_pred, nu, C, R, joseph)
-            Ks[k] = K
-            nus[k] = nu
-            Ss[k] = S
+            out.correction(k, K, nu, S)
         elif observed[k].any():
             idx = np.flatnonzero(observed[k])
             C_k = C[idx]
             nu = Y[k, idx] - C_k.dot(x_pred)
             x, P, K, S = _correct(x_pred, P_pred, nu, C_k, R[np.ix_(idx, idx)], joseph)
-            Ks[k][:, idx] = K
-            nus[k, idx] = nu
-            Ss[k][np.ix_(idx, idx)] = S
+            out.correction(k, K, nu, S, idx)
         else:
             x, P = x_pred, P_pred
-        xs[k] = x
-        Ps[k] = P
-
-    return FilterResult(
-        x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss, observed=observed
-    )
+        out.x_pred[k] = x_pred
+        out.P_pred[k] = P_pred
+        out.x[k] = x
+        out.P[k] = P
+    return out.result()

@@ -6,7 +6,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-__all__ = ["FilterResult", "freeze"]
+__all__ = ["FilterResult", "FilterHistory", "freeze"]
 
 
 def freeze(arr: np.ndarray) -> np.ndarray:
@@ -80,3 +80,40 @@ class FilterResult:
         T, n = self.x.shape
         m = self.innovation.shape[1]
         return f"FilterResult(T={T}, n={n}, m={m})"
+
+
+class FilterHistory:
+    """Tableaux préalloués qu'une boucle de filtre remplit pas à pas, puis fige en :class:`FilterResult`.
+
+    Usage interne des boucles (``kalman_filter``, filtres étendus) : elles écrivent ``x[k]``, ``P[k]``,
+    ``x_pred[k]``, ``P_pred[k]`` directement et confient la correction à :meth:`correction`, qui range
+    le gain, l'innovation et sa covariance aux composantes observées.
+    """
+
+    def __init__(self, T: int, n: int, m: int, observed: np.ndarray, iterated: bool = False) -> None:
+        self.x = np.empty((T, n))
+        self.P = np.empty((T, n, n))
+        self.x_pred = np.empty((T, n))
+        self.P_pred = np.empty((T, n, n))
+        self.K = np.zeros((T, n, m))  # gain nul pour une composante manquante : aucune correction
+        self.innovation = np.full((T, m), np.nan)
+        self.S = np.full((T, m, m), np.nan)
+        self.observed = observed
+        self.n_iter = np.zeros(T, dtype=int) if iterated else None
+
+    def correction(self, k: int, K: np.ndarray, nu: np.ndarray, S: np.ndarray, idx: np.ndarray | None = None):
+        """Range la correction du pas ``k`` ; ``idx`` : indices des composantes observées (``None`` : toutes)."""
+        if idx is None:
+            self.K[k] = K
+            self.innovation[k] = nu
+            self.S[k] = S
+        else:
+            self.K[k][:, idx] = K
+            self.innovation[k, idx] = nu
+            self.S[k][np.ix_(idx, idx)] = S
+
+    def result(self) -> FilterResult:
+        return FilterResult(
+            x=self.x, P=self.P, x_pred=self.x_pred, P_pred=self.P_pred, K=self.K,
+            innovation=self.innovation, S=self.S, observed=self.observed, n_iter=self.n_iter,
+        )

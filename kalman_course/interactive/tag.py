@@ -56,7 +56,7 @@ def tag_panels() -> tuple[Panel, ...]:
     L, W = TAG_ROOM
     return (
         Panel(
-            "Trajectoire dans la pièce de 10 m × 8 m (ancres aux quatre coins)",
+            "Trajectoire dans la pièce de 10 m × 8 m (vue de dessus)",
             "y (m)",
             (
                 Glyph("py_true", "line", "green", "trajectoire vraie", x="px_true"),
