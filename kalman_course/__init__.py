@@ -7,6 +7,24 @@ d'ipywidgets).
 """
 
 from . import errata, figures, scenarios
+# cohérence
+from .consistency import (
+    CentringTest,
+    ChiSquareTest,
+    ConsistencyRuns,
+    WhitenessTest,
+    autocorrelation,
+    centring_test,
+    chi2_band,
+    chi2_mean_test,
+    consistency_table,
+    monte_carlo_consistency,
+    nees,
+    nis,
+    nis_test,
+    whitened_innovations,
+    whiteness_test,
+)
 from .ekf import (
     IteratedUpdate,
     ekf_predict,
@@ -34,6 +52,35 @@ from .simulate import MonteCarlo, Simulation, monte_carlo, simulate
 from .tables import Table
 from .ukf_reference import filterpy_unscented_filter
 from .validation import KalmanInputError
+# filtre d'information en racine carrée
+from . import srif
+from .srif import (
+    SquareRootInformation,
+    SrifUpdate,
+    StateEstimate,
+    extended_square_root_information_filter,
+    extended_srif_predict,
+    extended_srif_update,
+    information_to_state,
+    square_root_information_filter,
+    srif_predict,
+    srif_update,
+    state_to_information,
+)
+# EKF itéré sur SE(3)
+from . import camera, errata_se3, lie, manifold
+from .camera import PinholeCamera, camera_measurement, camera_measurement_jacobian
+from .lie import oplus, ominus, se3_adjoint, se3_exp, se3_log, se3_right_jacobian
+from .manifold import (
+    SE3FilterResult,
+    SE3Update,
+    se3_ekf_update,
+    se3_iekf_update,
+    se3_iterated_filter,
+    se3_map_cost,
+    se3_nees,
+    se3_predict,
+)
 
 __all__ = [
     # modèles, résultat, erreurs
@@ -57,6 +104,22 @@ __all__ = [
     "mean_error_recursion",
     "measurement_initialisation",
     "spectral_radius",
+    # cohérence (tests statistiques)
+    "ChiSquareTest",
+    "WhitenessTest",
+    "CentringTest",
+    "ConsistencyRuns",
+    "nis",
+    "nees",
+    "whitened_innovations",
+    "chi2_band",
+    "chi2_mean_test",
+    "nis_test",
+    "autocorrelation",
+    "whiteness_test",
+    "centring_test",
+    "monte_carlo_consistency",
+    "consistency_table",
     # filtrage non linéaire
     "IteratedUpdate",
     "ekf_predict",
@@ -70,12 +133,47 @@ __all__ = [
     "numerical_jacobian",
     "wrap_angle",
     "filterpy_unscented_filter",
+    # filtre d'information en racine carrée
+    "SquareRootInformation",
+    "SrifUpdate",
+    "StateEstimate",
+    "srif_predict",
+    "srif_update",
+    "state_to_information",
+    "information_to_state",
+    "square_root_information_filter",
+    "extended_srif_predict",
+    "extended_srif_update",
+    "extended_square_root_information_filter",
+    "srif",
     # simulation et présentation
     "Simulation",
     "simulate",
     "MonteCarlo",
     "monte_carlo",
     "Table",
+    # EKF itéré sur SE(3)
+    "PinholeCamera",
+    "camera_measurement",
+    "camera_measurement_jacobian",
+    "oplus",
+    "ominus",
+    "se3_adjoint",
+    "se3_exp",
+    "se3_log",
+    "se3_right_jacobian",
+    "SE3FilterResult",
+    "SE3Update",
+    "se3_ekf_update",
+    "se3_iekf_update",
+    "se3_iterated_filter",
+    "se3_map_cost",
+    "se3_nees",
+    "se3_predict",
+    "camera",
+    "errata_se3",
+    "lie",
+    "manifold",
     # sous-modules
     "errata",
     "figures",

@@ -24,6 +24,12 @@ LINEAR_CHAPTERS = [
     "controle-systeme", "estimateur", "predicteur-correcteur", "gain-optimal", "tension-constante",
     "pratique-synthese",
 ]
+# Tous les chapitres du livre (hors introduction et références), tels que _toc.yml les liste.
+ALL_CHAPTERS = [
+    Path(f).name
+    for f in [c["file"] for part in yaml.safe_load((ROOT / "_toc.yml").read_text())["parts"] for c in part["chapters"]]
+    if Path(f).name != "references"
+]
 # Seul bruit toléré dans le journal : l'avertissement d'ipykernel sur le transport TCP local des noyaux
 # (TOOLCHAIN.md : « Console noise that is not an error »).
 TOLERATED = re.compile(r"\[IPKernelApp\] WARNING \| Kernel is running over TCP without encryption")
@@ -51,7 +57,7 @@ def test_toc_has_the_lecture_order_and_references_last():
     assert files[-1] == "book/references"
 
 
-@pytest.mark.parametrize("chapter", LINEAR_CHAPTERS)
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
 def test_chapters_hold_no_plotting_code_and_draw_registered_figures(chapter):
     text = (BOOK / f"{chapter}.md").read_text()
     code = "\n".join(_code_cells(text))
@@ -65,7 +71,7 @@ def test_chapters_hold_no_plotting_code_and_draw_registered_figures(chapter):
     assert sorted(set(drawn)) == sorted(own), f"{chapter} : figures du registre non montrées"
 
 
-@pytest.mark.parametrize("chapter", LINEAR_CHAPTERS)
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
 def test_each_chapter_has_an_exercise_with_a_hidden_computed_solution(chapter):
     text = (BOOK / f"{chapter}.md").read_text()
     labels = re.findall(r"```\{exercise\}\n:label: (\S+)", text)
@@ -104,7 +110,7 @@ def test_no_cell_output_is_an_error(built_book):
 
 
 @pytest.mark.book
-@pytest.mark.parametrize("chapter", LINEAR_CHAPTERS)
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
 def test_chapter_pages_show_math_figures_and_glued_numbers(built_book, chapter):
     html = (built_book / "book" / f"{chapter}.html").read_text()
     text = (BOOK / f"{chapter}.md").read_text()

@@ -9,10 +9,13 @@ from . import estimator  # noqa: F401  (chapitre « Construction d'un estimateur
 from . import gain  # noqa: F401  (chapitres « Prédicteur–correcteur » et « Gain optimal »)
 from . import voltage  # noqa: F401  (enregistre les figures du chapitre)
 from . import practice  # noqa: F401  (chapitre « Implémentation pratique et synthèse »)
+from . import consistency  # noqa: F401  (chapitre « Vérifier les hypothèses : tests statistiques »)
 from . import ekf  # noqa: F401  (chapitre « Dynamique non linéaire — le filtre de Kalman étendu »)
 from . import tag  # noqa: F401  (chapitre « Exemple — suivi d'un tag radio (UWB) »)
 from . import iekf  # noqa: F401  (chapitre « Filtre de Kalman étendu itéré »)
 from . import ukf  # noqa: F401  (chapitre « Pour aller plus loin » : UKF de filterpy)
+from . import srif  # noqa: F401  (chapitre « Filtre d'information en racine carrée (SRIF) »)
+from . import se3  # noqa: F401  (chapitre « EKF itéré sur SE(3) : pose d'une cible vue par une caméra »)
 from ._registry import REGISTRY, FigureSpec, draw, names, new_figure, register
 
 __all__ = ["REGISTRY", "FigureSpec", "draw", "names", "new_figure", "register"]
