@@ -115,6 +115,22 @@ def _drop_colab_for_markdown(app, pagename, templatename, context, doctree) -> N
     ]
 
 
+def _drop_duplicate_inline_scripts(app, pagename, templatename, context, doctree) -> None:
+    """sphinx-thebe (chargée d'office par Jupyter Book) ajoute deux fois son script en ligne
+    « const THEBE_JS_URL = … » : la seconde déclaration d'une même constante est une erreur de page.
+    On garde une seule copie de chaque script en ligne identique."""
+    seen: set[str] = set()
+    kept = []
+    for script in context.get("script_files", []):
+        body = getattr(script, "attributes", {}).get("body") if not isinstance(script, str) else None
+        if body:
+            if body in seen:
+                continue
+            seen.add(body)
+        kept.append(script)
+    context["script_files"] = kept
+
+
 def setup(app):
     app.add_config_value("kc_ipynb_download", False, "html", types=[bool])
     app.connect("config-inited", _guard_launch_buttons, priority=900)
@@ -124,4 +140,5 @@ def setup(app):
     # le bouton Colab retiré après (502)
     app.connect("html-page-context", _ipynb_download, priority=500)
     app.connect("html-page-context", _drop_colab_for_markdown, priority=502)
+    app.connect("html-page-context", _drop_duplicate_inline_scripts, priority=900)
     return {"version": BOKEH_VERSION, "parallel_read_safe": True, "parallel_write_safe": True}
