@@ -25,7 +25,14 @@ import scipy.linalg
 from .kf import Prediction, Update, _check_state, _correct, _symmetrize
 from .models import NonlinearModel
 from .results import FilterHistory, FilterResult
-from .validation import KalmanInputError, as_controls, as_measurements, as_vector, check_control_allowed
+from .validation import (
+    KalmanInputError,
+    as_controls,
+    as_measurements,
+    as_vector,
+    check_control_allowed,
+    check_instance,
+)
 
 __all__ = [
     "IteratedUpdate",
@@ -68,12 +75,9 @@ class IteratedUpdate(NamedTuple):
 
 
 def _check_model(model: Any) -> NonlinearModel:
-    if not isinstance(model, NonlinearModel):
-        raise KalmanInputError(
-            f"« model » doit être un NonlinearModel ; reçu {type(model).__name__} "
-            "(pour un modèle linéaire, utilisez kalman_filter ou NonlinearModel.from_linear)."
-        )
-    return model
+    return check_instance(
+        "model", model, NonlinearModel, "pour un modèle linéaire, utilisez kalman_filter ou NonlinearModel.from_linear"
+    )
 
 
 def _check_control(model: NonlinearModel, u: Any) -> np.ndarray | None:
@@ -272,10 +276,7 @@ def _run(model, y, x0, P0, u, correct) -> FilterResult:
             out.correction(k, K, nu, S, idx)
         else:
             x, P = x_pred, P_pred
-        out.x_pred[k] = x_pred
-        out.P_pred[k] = P_pred
-        out.x[k] = x
-        out.P[k] = P
+        out.store(k, x_pred, P_pred, x, P)
     return out.result()
 
 

@@ -23,6 +23,7 @@ from .validation import (
     as_square_matrix,
     as_vector,
     check_psd,
+    check_instance,
 )
 
 __all__ = [
@@ -35,8 +36,7 @@ __all__ = [
 
 
 def _check_square_observation(model: LinearGaussianModel, formula: str) -> None:
-    if not isinstance(model, LinearGaussianModel):
-        raise KalmanInputError(f"« model » doit être un LinearGaussianModel ; reçu {type(model).__name__}.")
+    check_instance("model", model, LinearGaussianModel)
     n, m = model.n_state, model.n_obs
     if n != m:
         raise KalmanInputError(
@@ -120,8 +120,7 @@ def printed_stability_radius(model: LinearGaussianModel, K: Any) -> float:
     r"""La condition de stabilité **telle qu'imprimée** (lignes 110 et 123, erratum 001-3) :
     rayon spectral de :math:`I - KC`, alors que l'erreur moyenne est propagée par :math:`(I - KC)A`
     (voir :func:`kalman_course.estimator.error_transition`). ``K`` (n, m)."""
-    if not isinstance(model, LinearGaussianModel):
-        raise KalmanInputError(f"« model » doit être un LinearGaussianModel ; reçu {type(model).__name__}.")
+    check_instance("model", model, LinearGaussianModel)
     K_arr = as_matrix("K", K, model.n_state, model.n_obs)
     return spectral_radius(np.eye(model.n_state) - K_arr @ model.C)
 

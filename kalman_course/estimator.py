@@ -37,6 +37,7 @@ from .validation import (
     as_square_matrix,
     as_vector,
     check_psd,
+    check_instance,
 )
 
 __all__ = [
@@ -65,9 +66,7 @@ class MeanError(NamedTuple):
 
 
 def _check_model(model: Any) -> LinearGaussianModel:
-    if not isinstance(model, LinearGaussianModel):
-        raise KalmanInputError(f"« model » doit être un LinearGaussianModel ; reçu {type(model).__name__}.")
-    return model
+    return check_instance("model", model, LinearGaussianModel)
 
 
 def gains_sequence(model: LinearGaussianModel, K: Any, n_steps: int | None = None) -> np.ndarray:

@@ -23,6 +23,7 @@ from .validation import (
     as_square_matrix,
     as_vector,
     check_control_allowed,
+    check_instance,
     check_psd,
 )
 
@@ -224,10 +225,7 @@ def kalman_filter(
         ``x`` (T, n), ``P`` (T, n, n), ``x_pred``, ``P_pred``, ``K`` (T, n, m), ``innovation`` (T, m),
         ``S`` (T, m, m), ``observed`` (T, m).
     """
-    if not isinstance(model, LinearGaussianModel):
-        raise KalmanInputError(
-            f"« model » doit être un LinearGaussianModel ; reçu {type(model).__name__}."
-        )
+    check_instance("model", model, LinearGaussianModel)
     n, m = model.n_state, model.n_obs
     Y = as_measurements("y", y, m)
     T = Y.shape[0]
@@ -254,8 +252,5 @@ def kalman_filter(
             out.correction(k, K, nu, S, idx)
         else:
             x, P = x_pred, P_pred
-        out.x_pred[k] = x_pred
-        out.P_pred[k] = P_pred
-        out.x[k] = x
-        out.P[k] = P
+        out.store(k, x_pred, P_pred, x, P)
     return out.result()

@@ -101,6 +101,13 @@ class FilterHistory:
         self.observed = observed
         self.n_iter = np.zeros(T, dtype=int) if iterated else None
 
+    def store(self, k: int, x_pred: np.ndarray, P_pred: np.ndarray, x: np.ndarray, P: np.ndarray) -> None:
+        """Range la prédiction et l'estimation a posteriori du pas ``k``."""
+        self.x_pred[k] = x_pred
+        self.P_pred[k] = P_pred
+        self.x[k] = x
+        self.P[k] = P
+
     def correction(self, k: int, K: np.ndarray, nu: np.ndarray, S: np.ndarray, idx: np.ndarray | None = None):
         """Range la correction du pas ``k`` ; ``idx`` : indices des composantes observées (``None`` : toutes)."""
         if idx is None:

@@ -39,6 +39,7 @@ from .validation import (
     check_control_allowed,
     check_pd,
     check_psd,
+    check_instance,
 )
 
 __all__ = [
@@ -121,21 +122,16 @@ def _check_method(method: Any) -> str:
 
 
 def _check_linear(model: Any) -> LinearGaussianModel:
-    if not isinstance(model, LinearGaussianModel):
-        raise KalmanInputError(
-            f"« model » doit être un LinearGaussianModel ; reçu {type(model).__name__} "
-            "(pour un modèle non linéaire, utilisez extended_square_root_information_filter)."
-        )
-    return model
+    return check_instance(
+        "model", model, LinearGaussianModel,
+        "pour un modèle non linéaire, utilisez extended_square_root_information_filter",
+    )
 
 
 def _check_nonlinear(model: Any) -> NonlinearModel:
-    if not isinstance(model, NonlinearModel):
-        raise KalmanInputError(
-            f"« model » doit être un NonlinearModel ; reçu {type(model).__name__} "
-            "(pour un modèle linéaire, utilisez square_root_information_filter)."
-        )
-    return model
+    return check_instance(
+        "model", model, NonlinearModel, "pour un modèle linéaire, utilisez square_root_information_filter"
+    )
 
 
 # --------------------------------------------------------------------------- noyaux internes

@@ -25,6 +25,7 @@ __all__ = [
     "as_measurements",
     "as_controls",
     "check_control_allowed",
+    "check_instance",
 ]
 
 
@@ -216,3 +217,13 @@ def check_control_allowed(name: str, p: int) -> None:
             f"« {name} » est fourni mais le modèle n'a pas de matrice de commande B : "
             f"construisez le modèle avec B=… ou retirez « {name} »."
         )
+
+
+def check_instance(name: str, value: Any, cls: type, hint: str = "") -> Any:
+    """``value`` doit être une instance de ``cls`` (un modèle, le plus souvent) ; ``hint`` : piste en français."""
+    if not isinstance(value, cls):
+        extra = f" ({hint})" if hint else ""
+        raise KalmanInputError(
+            f"« {name} » doit être un {cls.__name__} ; reçu {type(value).__name__}{extra}."
+        )
+    return value
