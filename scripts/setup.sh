@@ -31,12 +31,21 @@ if [ ! -x .venv/bin/python ]; then
 fi
 stamp=.venv/.requirements.sha
 want=$(cat requirements.txt pyproject.toml | sha256sum | cut -d' ' -f1)
+pip_quiet() {
+  # pip dans un journal ; en cas d'échec, on montre la fin du journal et on s'arrête.
+  local logfile=.venv/pip-install.log
+  if ! .venv/bin/python -m pip install -q --disable-pip-version-check "$@" >"$logfile" 2>&1; then
+    log "ERREUR : pip install $* a échoué ; fin du journal ($logfile) :"
+    grep -v "^WARNING: Location" "$logfile" | tail -n 30 >&2
+    exit 1
+  fi
+}
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
   log "installation des dépendances Python (requirements.txt)…"
-  .venv/bin/python -m pip install -q --disable-pip-version-check --upgrade pip 2>&1 | grep -v "^WARNING: Location" >&2 || true
-  .venv/bin/python -m pip install -q --disable-pip-version-check -r requirements.txt 2>&1 | grep -v "^WARNING: Location" >&2 || true
-  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps -e . 2>&1 | grep -v -E "^WARNING: Location|BuildBackendWarning|^ |^$" >&2 || true
-  .venv/bin/python -c "import kalman_course, filterpy, myst_nb" || { log "ERREUR : installation Python incomplète"; exit 1; }
+  pip_quiet -r requirements.txt
+  pip_quiet --no-deps -e .
+  .venv/bin/python -c "import kalman_course, kalman_course.interactive, filterpy, myst_nb" \
+    || { log "ERREUR : installation Python incomplète"; exit 1; }
   echo "$want" > "$stamp"
 fi
 
