@@ -20,7 +20,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .validation import KalmanInputError, as_vector
+from .validation import KalmanInputError, as_vector, call_user_function, check_finite_output
 
 __all__ = ["JacobianCheck", "numerical_jacobian", "check_jacobian", "wrap_angle"]
 
@@ -36,28 +36,14 @@ def wrap_angle(a: Any) -> np.ndarray:
 
 
 def _evaluate(func: Callable[..., Any], x: np.ndarray, args: tuple, name: str) -> np.ndarray:
-    try:
-        out = func(x, *args)
-    except KalmanInputError:
-        raise
-    except Exception as exc:  # noqa: BLE001 — on rend l'erreur de l'utilisateur lisible
-        raise KalmanInputError(
-            f"La fonction « {name} » a échoué en x = {np.array2string(x, precision=4)} : "
-            f"{type(exc).__name__}: {exc}"
-        ) from exc
-    arr = np.asarray(out, dtype=float)
+    arr = np.asarray(call_user_function(name, func, x, args), dtype=float)
     if arr.ndim == 0:
         arr = arr.reshape(1)
     if arr.ndim != 1:
         raise KalmanInputError(
             f"La fonction « {name} » doit renvoyer un vecteur 1-D ; elle a renvoyé la forme {arr.shape}."
         )
-    if not np.isfinite(arr).all():
-        raise KalmanInputError(
-            f"La fonction « {name} » a renvoyé des valeurs non finies (NaN ou infini) en "
-            f"x = {np.array2string(x, precision=4)}."
-        )
-    return arr
+    return check_finite_output(name, arr, x)
 
 
 def numerical_jacobian(

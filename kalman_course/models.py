@@ -26,6 +26,8 @@ from .validation import (
     as_float_array,
     as_matrix,
     as_square_matrix,
+    call_user_function,
+    check_finite_output,
     check_pd,
     check_psd,
 )
@@ -250,11 +252,11 @@ class NonlinearModel:
 
     def transition(self, x: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
         r""":math:`f(x, u)`, forme (n,), vérifiée (taille, valeurs finies)."""
-        return _checked_vector("f", _call("f", self.f, x, (u,)), self.n_state, "n", x)
+        return _checked_vector("f", call_user_function("f", self.f, x, (u,)), self.n_state, "n", x)
 
     def observe(self, x: np.ndarray) -> np.ndarray:
         r""":math:`h(x)`, forme (m,), vérifiée (taille, valeurs finies)."""
-        return _checked_vector("h", _call("h", self.h, x, ()), self.n_obs, "m", x)
+        return _checked_vector("h", call_user_function("h", self.h, x), self.n_obs, "m", x)
 
     def transition_jacobian(self, x: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
         r""":math:`F = J^A = \partial f/\partial x` en :math:`(x, u)`, forme (n, n) (analytique ou différences centrées)."""
@@ -330,18 +332,6 @@ def _constant_or_callable(name: str, value: Any, shape: tuple[int, int]) -> Any:
     return _readonly(as_matrix(name, value, shape[0], shape[1]))
 
 
-def _call(name: str, func: Callable[..., Any], x: np.ndarray, args: tuple) -> Any:
-    try:
-        return func(x, *args)
-    except KalmanInputError:
-        raise
-    except Exception as exc:  # noqa: BLE001 — l'erreur de l'utilisateur, nommée
-        raise KalmanInputError(
-            f"La fonction « {name} » a échoué en x = {np.array2string(np.asarray(x), precision=4)} : "
-            f"{type(exc).__name__}: {exc}"
-        ) from exc
-
-
 def _checked_vector(name: str, value: Any, size: int, letter: str, x: np.ndarray) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
     if arr.ndim == 0 and size == 1:
@@ -352,17 +342,12 @@ def _checked_vector(name: str, value: Any, size: int, letter: str, x: np.ndarray
             f"La fonction « {name} » doit renvoyer un vecteur de forme ({size},) ({letter} = {size}, "
             f"dimension de {what}) ; elle a renvoyé la forme {arr.shape}."
         )
-    if not np.isfinite(arr).all():
-        raise KalmanInputError(
-            f"La fonction « {name} » a renvoyé des valeurs non finies (NaN ou infini) en "
-            f"x = {np.array2string(np.asarray(x), precision=4)}."
-        )
-    return arr
+    return check_finite_output(name, arr, x)
 
 
 def _checked_matrix(name: str, value: Any, x: np.ndarray, args: tuple, shape: tuple[int, int]) -> np.ndarray:
     if callable(value):
-        value = _call(name, value, x, args)
+        value = call_user_function(name, value, x, args)
     arr = np.asarray(value, dtype=float)
     if arr.ndim == 0 and shape == (1, 1):
         arr = arr.reshape(1, 1)
@@ -370,9 +355,4 @@ def _checked_matrix(name: str, value: Any, x: np.ndarray, args: tuple, shape: tu
         raise KalmanInputError(
             f"La jacobienne « {name} » doit être de forme {shape} ; elle a la forme {arr.shape}."
         )
-    if not np.isfinite(arr).all():
-        raise KalmanInputError(
-            f"La jacobienne « {name} » contient des valeurs non finies (NaN ou infini) en "
-            f"x = {np.array2string(np.asarray(x), precision=4)}."
-        )
-    return arr
+    return check_finite_output(name, arr, x, what="La jacobienne")

@@ -26,6 +26,8 @@ __all__ = [
     "as_controls",
     "check_control_allowed",
     "check_instance",
+    "call_user_function",
+    "check_finite_output",
 ]
 
 
@@ -227,3 +229,28 @@ def check_instance(name: str, value: Any, cls: type, hint: str = "") -> Any:
             f"« {name} » doit être un {cls.__name__} ; reçu {type(value).__name__}{extra}."
         )
     return value
+
+
+def call_user_function(name: str, func: Any, x: np.ndarray, args: tuple = ()) -> Any:
+    """Appelle une fonction fournie par l'utilisateur (``f``, ``h``, une jacobienne…) en ``x`` ; toute
+    exception devient une :class:`KalmanInputError` qui nomme la fonction et le point."""
+    try:
+        return func(x, *args)
+    except KalmanInputError:
+        raise
+    except Exception as exc:  # noqa: BLE001 — l'erreur de l'utilisateur, rendue lisible
+        raise KalmanInputError(
+            f"La fonction « {name} » a échoué en x = {np.array2string(np.asarray(x), precision=4)} : "
+            f"{type(exc).__name__}: {exc}"
+        ) from exc
+
+
+def check_finite_output(name: str, arr: np.ndarray, x: np.ndarray, what: str = "La fonction") -> np.ndarray:
+    """Le résultat ``arr`` d'une fonction de l'utilisateur évaluée en ``x`` doit être fini."""
+    if not np.isfinite(arr).all():
+        verb = "a renvoyé" if what == "La fonction" else "contient"
+        raise KalmanInputError(
+            f"{what} « {name} » {verb} des valeurs non finies (NaN ou infini) en "
+            f"x = {np.array2string(np.asarray(x), precision=4)}."
+        )
+    return arr
