@@ -29,7 +29,7 @@ import scipy.stats
 
 from .kf import kalman_filter
 from .models import LinearGaussianModel
-from .results import FilterResult, freeze
+from .results import FilterResult, freeze, freeze_fields
 from .simulate import as_generator, simulate
 from .tables import Table
 from .validation import KalmanInputError, as_controls, as_float_array, as_square_matrix, as_vector, check_pd
@@ -412,8 +412,7 @@ class WhitenessTest:
         lags = np.array(self.lags, dtype=int, copy=True)
         lags.setflags(write=False)
         object.__setattr__(self, "lags", lags)
-        for name in ("autocorrelation", "ljung_box", "component_p_values"):
-            object.__setattr__(self, name, freeze(getattr(self, name)))
+        freeze_fields(self, "autocorrelation", "ljung_box", "component_p_values")
 
     def __str__(self) -> str:
         verdict = "blanches" if self.white else "non blanches : hypothèse rejetée"
@@ -497,8 +496,7 @@ class CentringTest:
     centred: bool
 
     def __post_init__(self) -> None:
-        for name in ("mean", "t_statistic", "t_p_values"):
-            object.__setattr__(self, name, freeze(getattr(self, name)))
+        freeze_fields(self, "mean", "t_statistic", "t_p_values")
 
     def __str__(self) -> str:
         verdict = "centrées" if self.centred else "non centrées : hypothèse rejetée"

@@ -33,7 +33,7 @@ from .lie import (
     _se3_log,
     as_pose,
 )
-from .results import freeze
+from .results import freeze_fields
 from .validation import KalmanInputError, as_float_array, as_square_matrix, as_vector, check_pd, check_psd
 
 __all__ = [
@@ -97,8 +97,7 @@ class SE3FilterResult:
     n_iter: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("T", "P", "T_pred", "P_pred"):
-            object.__setattr__(self, name, freeze(getattr(self, name)))
+        freeze_fields(self, "T", "P", "T_pred", "P_pred")
         n = np.array(self.n_iter, dtype=int, copy=True)
         n.setflags(write=False)
         object.__setattr__(self, "n_iter", n)

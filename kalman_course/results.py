@@ -6,7 +6,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-__all__ = ["FilterResult", "FilterHistory", "freeze"]
+__all__ = ["FilterResult", "FilterHistory", "freeze", "freeze_fields"]
 
 
 def freeze(arr: np.ndarray) -> np.ndarray:
@@ -14,6 +14,13 @@ def freeze(arr: np.ndarray) -> np.ndarray:
     out = np.array(arr, dtype=float, copy=True)
     out.setflags(write=False)
     return out
+
+
+def freeze_fields(obj, *names: str) -> None:
+    """Dans le ``__post_init__`` d'une dataclass figée : remplace les champs ``names`` par des copies
+    ``float`` en lecture seule."""
+    for name in names:
+        object.__setattr__(obj, name, freeze(getattr(obj, name)))
 
 
 @dataclass(frozen=True, eq=False)

@@ -9,7 +9,7 @@ import numpy as np
 import scipy.linalg
 
 from .models import LinearGaussianModel
-from .results import freeze
+from .results import freeze_fields
 from .validation import KalmanInputError, as_controls, as_square_matrix, as_vector, check_psd
 
 __all__ = ["MonteCarlo", "Simulation", "as_generator", "covariance_factor", "monte_carlo", "simulate"]
@@ -23,8 +23,7 @@ class Simulation:
     y: np.ndarray
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "x", freeze(self.x))
-        object.__setattr__(self, "y", freeze(self.y))
+        freeze_fields(self, "x", "y")
 
 
 def as_generator(rng: Any) -> np.random.Generator:
@@ -92,8 +91,7 @@ class MonteCarlo:
     x0_hat: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("x0", "x", "y", "x_hat", "x0_hat"):
-            object.__setattr__(self, name, freeze(getattr(self, name)))
+        freeze_fields(self, "x0", "x", "y", "x_hat", "x0_hat")
 
     @property
     def n_runs(self) -> int:

@@ -22,7 +22,7 @@ import scipy.optimize
 from ..camera import PinholeCamera, camera_measurement
 from ..lie import se3_exp, se3_inverse, se3_log
 from ..manifold import SE3FilterResult, se3_iekf_update, se3_iterated_filter, se3_map_cost, se3_nees
-from ..results import freeze
+from ..results import freeze, freeze_fields
 from ..simulate import as_generator
 from ..tables import Table
 
@@ -89,8 +89,7 @@ class CameraTargetProblem:
     sigma_px: float
 
     def __post_init__(self) -> None:
-        for name in ("T_pred", "P_pred", "y", "T_true", "points"):
-            object.__setattr__(self, name, freeze(getattr(self, name)))
+        freeze_fields(self, "T_pred", "P_pred", "y", "T_true", "points")
 
     def iekf(self, max_iter: int = 20, tol: float = 1e-10, **kwargs):
         """:func:`~kalman_course.manifold.se3_iekf_update` sur ce problème."""

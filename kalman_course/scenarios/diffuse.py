@@ -22,7 +22,7 @@ import scipy.linalg
 
 from ..kf import kalman_filter
 from ..models import LinearGaussianModel
-from ..results import freeze
+from ..results import freeze_fields
 from ..srif import square_root_information_filter
 from ..validation import KalmanInputError
 from ._motion import _cv_noise_gain, cv_process_noise, cv_transition, simulate_cv
@@ -169,8 +169,7 @@ class DiffuseErrors:
     reference: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("exponents", "kf", "srif", "reference"):
-            object.__setattr__(self, name, freeze(getattr(self, name)))
+        freeze_fields(self, "exponents", "kf", "srif", "reference")
         failed = np.array(self.kf_failed, dtype=bool)
         failed.setflags(write=False)
         object.__setattr__(self, "kf_failed", failed)

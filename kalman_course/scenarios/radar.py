@@ -21,7 +21,7 @@ import scipy.optimize
 from ..ekf import ekf_update, iekf_update, map_cost
 from ..errata_iekf import no_correction_iterates, table_literal_iterates
 from ..models import NonlinearModel
-from ..results import freeze
+from ..results import freeze, freeze_fields
 from ..simulate import as_generator
 from ..tables import Table
 from ._motion import cv_process_noise, cv_transition, simulate_cv
@@ -106,8 +106,7 @@ class RadarUpdateProblem:
     truth: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("x_pred", "P_pred", "y", "truth"):
-            object.__setattr__(self, name, freeze(getattr(self, name)))
+        freeze_fields(self, "x_pred", "P_pred", "y", "truth")
 
 
 def radar_update_problem(rng: Any = RADAR_SEED) -> RadarUpdateProblem:

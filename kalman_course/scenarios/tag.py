@@ -23,7 +23,7 @@ import numpy as np
 
 from ..ekf import extended_kalman_filter
 from ..models import NonlinearModel
-from ..results import FilterResult, freeze
+from ..results import FilterResult, freeze_fields
 from ..simulate import as_generator
 from ..tables import Table
 from ..validation import KalmanInputError
@@ -137,8 +137,7 @@ class TagData:
     P0: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("t", "x_true", "y", "anchors", "x0", "P0"):
-            object.__setattr__(self, name, freeze(getattr(self, name)))
+        freeze_fields(self, "t", "x_true", "y", "anchors", "x0", "P0")
 
 
 def tag_trajectory(t: Any) -> np.ndarray:
