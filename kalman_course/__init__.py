@@ -6,9 +6,10 @@ les démontrer) et ``interactive`` (curseurs ; importé à la demande, seul à d
 d'ipywidgets).
 """
 
-from . import errata, figures, scenarios
+from .lecture import errata
+from . import figures, scenarios
 # cohérence
-from .consistency import (
+from .diagnostics.consistency import (
     CentringTest,
     ChiSquareTest,
     ConsistencyRuns,
@@ -25,16 +26,9 @@ from .consistency import (
     whitened_innovations,
     whiteness_test,
 )
-from .ekf import (
-    IteratedUpdate,
-    ekf_predict,
-    ekf_update,
-    extended_kalman_filter,
-    iekf_update,
-    iterated_extended_kalman_filter,
-    map_cost,
-)
-from .estimator import (
+from .filters.extended import ekf_predict, ekf_update, extended_kalman_filter
+from .filters.iterated import IteratedUpdate, iekf_update, iterated_extended_kalman_filter, map_cost
+from .lecture.estimator import (
     MeanError,
     covariance_for_gain,
     error_transition,
@@ -44,17 +38,17 @@ from .estimator import (
     measurement_initialisation,
     spectral_radius,
 )
-from .jacobians import JacobianCheck, check_jacobian, numerical_jacobian, wrap_angle
-from .kf import Prediction, Update, kalman_filter, predict, recipe_step, update
-from .models import LinearGaussianModel, NonlinearModel
-from .results import FilterResult
-from .simulate import MonteCarlo, Simulation, monte_carlo, simulate
+from .core.jacobians import JacobianCheck, check_jacobian, numerical_jacobian, wrap_angle
+from .filters.kalman import Prediction, Update, kalman_filter, predict, recipe_step, update
+from .core.models import LinearGaussianModel, NonlinearModel
+from .core.results import FilterResult
+from .core.simulation import MonteCarlo, Simulation, monte_carlo, simulate
 from .tables import Table
-from .ukf_reference import filterpy_unscented_filter
-from .validation import KalmanInputError
+from .filters.filterpy_unscented import filterpy_unscented_filter
+from .core.validation import KalmanInputError
 # filtre d'information en racine carrée
-from . import srif
-from .srif import (
+from .filters import square_root_information as srif
+from .filters.square_root_information import (
     SquareRootInformation,
     SrifUpdate,
     StateEstimate,
@@ -68,10 +62,13 @@ from .srif import (
     state_to_information,
 )
 # EKF itéré sur SE(3)
-from . import camera, errata_se3, lie, manifold
-from .camera import PinholeCamera, camera_measurement, camera_measurement_jacobian
-from .lie import oplus, ominus, se3_adjoint, se3_exp, se3_log, se3_right_jacobian
-from .manifold import (
+from .geometry import camera, lie
+from .lecture import errata_se3
+from . import se3_filter
+manifold = se3_filter  # ancien nom du module
+from .geometry.camera import PinholeCamera, camera_measurement, camera_measurement_jacobian
+from .geometry.lie import oplus, ominus, se3_adjoint, se3_exp, se3_log, se3_right_jacobian
+from .se3_filter import (
     SE3FilterResult,
     SE3Update,
     se3_ekf_update,

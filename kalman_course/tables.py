@@ -8,7 +8,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .validation import KalmanInputError
+from .core.validation import KalmanInputError
 
 __all__ = ["Table"]
 

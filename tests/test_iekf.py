@@ -9,7 +9,7 @@ import scipy.optimize
 from conftest import random_model
 
 import kalman_course as kc
-from kalman_course.errata_iekf import (
+from kalman_course.lecture.errata_iekf import (
     measurement_only_iterates,
     no_correction_iterates,
     table_literal_iterates,

@@ -13,8 +13,8 @@ import pytest
 import scipy.linalg
 
 import kalman_course as kc
-from kalman_course import lie
-from kalman_course.jacobians import numerical_jacobian
+from kalman_course.geometry import lie
+from kalman_course.core.jacobians import numerical_jacobian
 
 RNG = np.random.default_rng(20240611)
 

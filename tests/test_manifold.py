@@ -16,8 +16,9 @@ import scipy.optimize
 import scipy.stats
 
 import kalman_course as kc
-from kalman_course import errata_se3, lie
-from kalman_course.camera import (
+from kalman_course.lecture import errata_se3
+from kalman_course.geometry import lie
+from kalman_course.geometry.camera import (
     PinholeCamera,
     camera_measurement,
     camera_measurement_jacobian,
@@ -25,7 +26,7 @@ from kalman_course.camera import (
     project,
     transform_points,
 )
-from kalman_course.jacobians import numerical_jacobian
+from kalman_course.core.jacobians import numerical_jacobian
 from kalman_course.scenarios import camera_target as ct
 
 CAM = PinholeCamera(fx=520.0, fy=500.0, cx=320.0, cy=240.0)
@@ -311,5 +312,5 @@ def test_other_bad_inputs_are_french_errors(problem):
         kc.se3_predict(np.eye(4), np.eye(6), np.zeros(3), np.eye(6))
     with pytest.raises(kc.KalmanInputError, match="« Q » doit être semi-définie positive"):
         kc.se3_predict(np.eye(4), np.eye(6), np.zeros(6), -np.eye(6))
-    with pytest.raises(kc.KalmanInputError, match=r"« y » doit être de forme \(F, 20\)"):
+    with pytest.raises(kc.KalmanInputError, match=r"« y » doit être de forme \(T, 20\)"):
         kc.se3_iterated_filter(np.zeros(20), problem.T_pred, problem.P_pred, problem.points, problem.camera, 1.0)

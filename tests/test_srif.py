@@ -12,7 +12,7 @@ from conftest import filterpy_kf
 from filterpy.kalman import InformationFilter
 
 import kalman_course as kc
-from kalman_course import srif
+from kalman_course.filters import square_root_information as srif
 from kalman_course.scenarios import diffuse
 from kalman_course.scenarios._motion import _cv_noise_gain
 

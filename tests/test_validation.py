@@ -71,7 +71,7 @@ def test_scalars_accepted_for_one_dimensional_model():
 @pytest.mark.parametrize(
     "kwargs, pattern",
     [
-        (dict(x0=[0.0, 0.0, 0.0]), r"« x0 » doit être un vecteur de forme \(2,\) ; reçu la forme \(3\)"),
+        (dict(x0=[0.0, 0.0, 0.0]), r"« x0 » doit être un vecteur de forme \(2,\) ; reçu la forme \(3,\)"),
         (dict(x0=[[0.0], [0.0]]), r"« x0 » .*vecteur colonne"),
         (dict(x0=[np.nan, 0.0]), r"« x0 » contient des valeurs non finies"),
         (dict(P0=np.eye(3)), r"« P0 » doit être de forme \(2, 2\)"),

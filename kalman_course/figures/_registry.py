@@ -8,7 +8,7 @@ from typing import Callable
 
 from matplotlib.figure import Figure
 
-from ..validation import KalmanInputError
+from ..core.validation import KalmanInputError
 
 __all__ = ["CourseFigure", "FigureSpec", "REGISTRY", "register", "draw", "names", "new_figure"]
 

@@ -10,15 +10,15 @@ from __future__ import annotations
 import numpy as np
 import scipy.stats
 
-from ..consistency import (
+from ..diagnostics.consistency import (
     chi2_band,
     monte_carlo_consistency,
     nis,
     whitened_innovations,
     whiteness_test,
 )
-from ..kf import kalman_filter
-from ..models import LinearGaussianModel
+from ..filters.kalman import kalman_filter
+from ..core.models import LinearGaussianModel
 from ..scenarios.engine import (
     ENGINE_DT,
     ENGINE_P0,
@@ -31,7 +31,7 @@ from ..scenarios.engine import (
     engine_commands,
     engine_model,
 )
-from ..simulate import simulate
+from ..core.simulation import simulate
 from ._registry import new_figure, register
 
 CHAPTER = "tests-statistiques"

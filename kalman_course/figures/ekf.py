@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..ekf import ekf_predict
-from ..models import NonlinearModel
+from ..filters.extended import ekf_predict
+from ..core.models import NonlinearModel
 from ._geometry import draw_ellipse
 from ._registry import new_figure, register
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..estimator import linear_estimator, mean_error_recursion
-from ..kf import kalman_filter
-from ..models import LinearGaussianModel
+from ..lecture.estimator import linear_estimator, mean_error_recursion
+from ..filters.kalman import kalman_filter
+from ..core.models import LinearGaussianModel
 from ..scenarios.engine import (
     ENGINE_DT,
     ENGINE_SEED,
@@ -16,7 +16,7 @@ from ..scenarios.engine import (
     engine_commands,
     engine_model,
 )
-from ..simulate import monte_carlo, simulate
+from ..core.simulation import monte_carlo, simulate
 from ._registry import new_figure, register
 
 CHAPTER = "estimateur"

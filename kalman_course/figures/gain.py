@@ -6,9 +6,9 @@ import numpy as np
 import scipy.linalg
 import scipy.stats
 
-from ..errata import printed_recipe_filter
-from ..estimator import covariance_for_gain
-from ..kf import kalman_filter
+from ..lecture.errata import printed_recipe_filter
+from ..lecture.estimator import covariance_for_gain
+from ..filters.kalman import kalman_filter
 from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
 from ..scenarios.engine import (
     ENGINE_DT,
@@ -20,7 +20,7 @@ from ..scenarios.engine import (
     engine_commands,
     engine_model,
 )
-from ..simulate import monte_carlo, simulate
+from ..core.simulation import monte_carlo, simulate
 from ._registry import new_figure, register
 
 CHAPTER_LOOP = "predicteur-correcteur"

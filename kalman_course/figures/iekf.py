@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..ekf import map_cost
+from ..filters.iterated import map_cost
 from ..scenarios.radar import radar_iterations
 from ._geometry import draw_ellipse
 from ._registry import new_figure, register

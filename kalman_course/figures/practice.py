@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kf import kalman_filter
-from ..models import LinearGaussianModel
+from ..filters.kalman import kalman_filter
+from ..core.models import LinearGaussianModel
 from ..scenarios.engine import (
     ENGINE_DT,
     ENGINE_P0,
@@ -15,7 +15,7 @@ from ..scenarios.engine import (
     engine_commands,
     engine_model,
 )
-from ..simulate import simulate
+from ..core.simulation import simulate
 from ._registry import new_figure, register
 
 CHAPTER = "pratique-synthese"

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..camera import camera_measurement
-from ..errata_se3 import notes_literal_iterates
-from ..lie import se3_inverse, se3_log
+from ..geometry.camera import camera_measurement
+from ..lecture.errata_se3 import notes_literal_iterates
+from ..geometry.lie import se3_inverse, se3_log
 from ..scenarios.camera_target import camera_map_estimate, camera_target_problem
 from ._registry import new_figure, register
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..scenarios.engine import ENGINE_DT, ENGINE_SEED, engine_commands, engine_model
-from ..simulate import simulate
+from ..core.simulation import simulate
 from ._registry import new_figure, register
 
 CHAPTER = "controle-systeme"

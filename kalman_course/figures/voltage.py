@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kf import kalman_filter
+from ..filters.kalman import kalman_filter
 from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
 from ._registry import new_figure, register
 

@@ -17,8 +17,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from ..results import freeze
-from ..validation import KalmanInputError, as_float_array
+from ..core.results import freeze
+from ..core.validation import KalmanInputError, as_float_array, shape_text
 
 __all__ = ["ParameterAxis", "ParameterGrid", "log_grid", "precompute_grid", "format_value"]
 
@@ -68,7 +68,7 @@ class ParameterAxis:
         if values.ndim != 1 or values.size < 2:
             raise KalmanInputError(
                 f"Les valeurs de « {self.name} » doivent former un vecteur d'au moins 2 valeurs ; "
-                f"reçu la forme {values.shape}."
+                f"reçu {shape_text(values.shape)}."
             )
         if not (values > 0).all() or not (np.diff(values) > 0).all():
             raise KalmanInputError(
@@ -179,7 +179,7 @@ def precompute_grid(
             raise KalmanInputError(f"« {label} » doit être un ParameterAxis ; reçu {type(axis).__name__}.")
     t = as_float_array("time", time)
     if t.ndim != 1 or t.size == 0:
-        raise KalmanInputError(f"« time » doit être un vecteur non vide ; reçu la forme {t.shape}.")
+        raise KalmanInputError(f"« time » doit être un vecteur non vide ; reçu {shape_text(t.shape)}.")
     n0, n1, T = first.values.size, second.values.size, t.size
     series: dict[str, np.ndarray] = {}
     for i, a in enumerate(first.values):

@@ -20,7 +20,7 @@ import ipywidgets as widgets
 import numpy as np
 
 from ..figures import new_figure
-from ..validation import KalmanInputError, as_float_array
+from ..core.validation import KalmanInputError, as_float_array
 from .spec import Panel, check_columns
 
 __all__ = ["LogParameter", "LiveExplorer"]

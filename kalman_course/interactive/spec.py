@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..validation import KalmanInputError
+from ..core.validation import KalmanInputError
 
 __all__ = ["Glyph", "Panel"]
 

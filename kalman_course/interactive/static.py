@@ -38,7 +38,7 @@ from bokeh.models import (
 )
 from bokeh.plotting import figure
 
-from ..validation import KalmanInputError, as_float_array
+from ..core.validation import KalmanInputError, as_float_array
 from .grid import ParameterGrid
 from .spec import Panel, check_columns
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..scenarios.tag import TAG_ACCEL_STD, TAG_RANGE_STD, TAG_ROOM, run_tag_ekf, tag_data
-from ..validation import KalmanInputError, as_float_array
+from ..core.validation import KalmanInputError, as_float_array
 from .grid import ParameterAxis, ParameterGrid, log_grid, precompute_grid
 from .spec import Glyph, Panel
 

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kf import kalman_filter
+from ..filters.kalman import kalman_filter
 from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
-from ..validation import KalmanInputError, as_float_array
+from ..core.validation import KalmanInputError, as_float_array
 from .grid import ParameterAxis, ParameterGrid, log_grid, precompute_grid
 from .spec import Glyph, Panel
 

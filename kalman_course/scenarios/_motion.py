@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..simulate import as_generator
+from ..core.simulation import as_generator
 
 __all__ = ["cv_transition", "cv_process_noise", "simulate_cv"]
 

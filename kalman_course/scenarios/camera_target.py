@@ -19,11 +19,11 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
-from ..camera import PinholeCamera, camera_measurement
-from ..lie import se3_exp, se3_inverse, se3_log
-from ..manifold import SE3FilterResult, se3_iekf_update, se3_iterated_filter, se3_map_cost, se3_nees
-from ..results import freeze, freeze_fields
-from ..simulate import as_generator
+from ..geometry.camera import PinholeCamera, camera_measurement
+from ..geometry.lie import se3_exp, se3_inverse, se3_log
+from ..se3_filter import SE3FilterResult, se3_iekf_update, se3_iterated_filter, se3_map_cost, se3_nees
+from ..core.results import freeze, freeze_fields
+from ..core.simulation import as_generator
 from ..tables import Table
 
 __all__ = [

@@ -20,11 +20,11 @@ from decimal import Decimal, localcontext
 import numpy as np
 import scipy.linalg
 
-from ..kf import kalman_filter
-from ..models import LinearGaussianModel
-from ..results import freeze_fields
-from ..srif import square_root_information_filter
-from ..validation import KalmanInputError
+from ..filters.kalman import kalman_filter
+from ..core.models import LinearGaussianModel
+from ..core.results import freeze_fields
+from ..filters.square_root_information import square_root_information_filter
+from ..core.validation import KalmanInputError
 from ._motion import _cv_noise_gain, cv_process_noise, cv_transition, simulate_cv
 
 __all__ = [

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..models import LinearGaussianModel
+from ..core.models import LinearGaussianModel
 
 __all__ = [
     "ENGINE_DT",

@@ -18,11 +18,12 @@ from typing import Any
 import numpy as np
 import scipy.optimize
 
-from ..ekf import ekf_update, iekf_update, map_cost
-from ..errata_iekf import no_correction_iterates, table_literal_iterates
-from ..models import NonlinearModel
-from ..results import freeze, freeze_fields
-from ..simulate import as_generator
+from ..filters.extended import ekf_update
+from ..filters.iterated import iekf_update, map_cost
+from ..lecture.errata_iekf import no_correction_iterates, table_literal_iterates
+from ..core.models import NonlinearModel
+from ..core.results import freeze, freeze_fields
+from ..core.simulation import as_generator
 from ..tables import Table
 from ._motion import cv_process_noise, cv_transition, simulate_cv
 

@@ -21,12 +21,12 @@ from typing import Any
 
 import numpy as np
 
-from ..ekf import extended_kalman_filter
-from ..models import NonlinearModel
-from ..results import FilterResult, freeze_fields
-from ..simulate import as_generator
+from ..filters.extended import extended_kalman_filter
+from ..core.models import NonlinearModel
+from ..core.results import FilterResult, freeze_fields
+from ..core.simulation import as_generator
 from ..tables import Table
-from ..validation import KalmanInputError
+from ..core.validation import KalmanInputError, shape_text
 from ._motion import cv_process_noise, cv_transition
 
 __all__ = [
@@ -111,7 +111,7 @@ def tag_model(
             raise KalmanInputError(f"« {name} » doit être un réel strictement positif ; reçu {value!r}.")
     A = np.array(anchors, dtype=float)
     if A.ndim != 2 or A.shape[1] != 2 or A.shape[0] < 1:
-        raise KalmanInputError(f"« anchors » doit être de forme (N, 2) ; reçu la forme {A.shape}.")
+        raise KalmanInputError(f"« anchors » doit être de forme (N, 2) ; reçu {shape_text(A.shape)}.")
     F = cv_transition(dt)
     return NonlinearModel(
         f=lambda x, u: F @ x,
@@ -191,7 +191,7 @@ def run_tag_ukf(
     accel_std: float = TAG_ACCEL_STD, range_std: float = TAG_RANGE_STD, data: TagData | None = None
 ) -> FilterResult:
     """Même problème avec le filtre de Kalman « unscented » de filterpy (voir :mod:`kalman_course.ukf_reference`)."""
-    from ..ukf_reference import filterpy_unscented_filter
+    from ..filters.filterpy_unscented import filterpy_unscented_filter
 
     data = tag_data() if data is None else data
     model = tag_model(accel_std, range_std, data.dt, data.anchors)

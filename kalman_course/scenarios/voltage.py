@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..models import LinearGaussianModel
-from ..simulate import as_generator
+from ..core.models import LinearGaussianModel
+from ..core.simulation import as_generator
 
 __all__ = [
     "TRUE_VOLTAGE",

@@ -14,9 +14,9 @@ import numpy as np
 import scipy.linalg
 
 from .estimator import spectral_radius
-from .models import LinearGaussianModel
-from .results import FilterResult
-from .validation import (
+from ..core.models import LinearGaussianModel
+from ..core.results import FilterResult
+from ..core.validation import (
     KalmanInputError,
     as_matrix,
     as_measurements,

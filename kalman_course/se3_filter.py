@@ -10,8 +10,10 @@ r"""EKF et EKF itéré sur SE(3) : pose d'une cible connue vue par une caméra �
   :math:`J(T) = \tfrac12\lVert\mathrm{Log}(\hat T_-^{-1}T)\rVert^2_{P_-^{-1}} + \tfrac12\lVert y - h(T)\rVert^2_{R^{-1}}`.
   Une seule itération est l'EKF sur la variété (:func:`se3_ekf_update`).
 
-Le gain et la covariance corrigée viennent de :func:`kalman_course.kf._correct` (le même code que le
-filtre linéaire). Ce module n'importe pas matplotlib.
+La correction est la boucle de Gauss–Newton commune (:func:`kalman_course.filters.iteration.gauss_newton_update`)
+avec les opérations de SE(3) (:data:`SE3_SPACE` : :math:`T \oplus \delta = T\,\mathrm{Exp}(\delta)`,
+:math:`T \ominus T_0 = \mathrm{Log}(T_0^{-1}T)`) ; la séquence d'images passe par le moteur commun
+(:func:`kalman_course.filters.engine.run_filter`), comme tous les filtres du paquet.
 """
 
 from __future__ import annotations
@@ -22,10 +24,12 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from .camera import PinholeCamera, _check_camera, _measure, _measurement_jacobian, as_points
-from .ekf import _check_iterations
-from .kf import _correct, _symmetrize
-from .lie import (
+from .core.linalg import cholesky_factor, symmetrize
+from .core.results import FilterResult
+from .filters.engine import Correction, FilterFamily, run_filter
+from .filters.iteration import DEFAULT_MAX_ITER, DEFAULT_TOL, StateSpace, check_iterations, gauss_newton_update
+from .geometry.camera import PinholeCamera, _check_camera, _measure, _measurement_jacobian, as_points
+from .geometry.lie import (
     _se3_adjoint,
     _se3_exp,
     _se3_inverse,
@@ -33,10 +37,12 @@ from .lie import (
     _se3_log,
     as_pose,
 )
-from .results import freeze_fields
-from .validation import KalmanInputError, as_float_array, as_square_matrix, as_vector, check_pd, check_psd
+from .core.validation import KalmanInputError, as_float_array, as_square_matrix, as_vector, check_pd, check_psd, shape_text
 
 __all__ = [
+    "CameraPoseModel",
+    "SE3_SPACE",
+    "se3_family",
     "SE3Prediction",
     "SE3Update",
     "SE3FilterResult",
@@ -48,8 +54,28 @@ __all__ = [
     "se3_iterated_filter",
 ]
 
-DEFAULT_MAX_ITER = 20
-DEFAULT_TOL = 1e-10
+
+def _se3_oplus(T: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    return T @ _se3_exp(delta)
+
+
+def _se3_ominus(T: np.ndarray, T0: np.ndarray) -> np.ndarray:
+    return _se3_log(_se3_inverse(T0) @ T)
+
+
+def _right_jacobian(xi: np.ndarray) -> np.ndarray:
+    return _se3_jl(-xi)  # J_r(ξ) = J_l(−ξ)
+
+
+def _transport(P: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    J = _right_jacobian(delta)
+    return J @ P @ J.T
+
+
+#: SE(3) pour Gauss–Newton : :math:`T\oplus\delta = T\,\mathrm{Exp}(\delta)`,
+#: :math:`T\ominus T_0 = \mathrm{Log}(T_0^{-1}T)`, a priori vu depuis :math:`T_i` avec
+#: :math:`\mathcal J_r(\xi_i)`, covariance finale transportée par :math:`\mathcal J_r(\delta_{N-1})`.
+SE3_SPACE = StateSpace(oplus=_se3_oplus, ominus=_se3_ominus, prior_jacobian=_right_jacobian, transport=_transport)
 
 
 class SE3Prediction(NamedTuple):
@@ -66,8 +92,9 @@ class SE3Update(NamedTuple):
     :math:`\hat T_+`) ; ``n_iter`` : nombre :math:`N` d'itérations ; ``converged`` : arrêt par ``tol`` ;
     ``iterates`` (N+1, 4, 4) : :math:`T_0 = \hat T_-, \dots, T_N` ; ``xi`` (N+1, 6) :
     :math:`\xi_i = \mathrm{Log}(\hat T_-^{-1}T_i)` ; ``steps`` (N, 6) : les pas :math:`\delta_i` ;
-    ``cost`` (N+1,) : :math:`J(T_i)` ; ``K`` (6, 2n) et ``S`` (2n, 2n) : gain et covariance d'innovation
-    de la dernière itération ; ``innovation`` (2n,) : :math:`y - h(\hat T_-)` (n points).
+    ``cost`` (N+1,) : :math:`J(T_i)` ; ``K`` (6, 2n), ``innovation`` (2n,) et ``S`` (2n, 2n) : gain,
+    innovation linéarisée :math:`r_{N-1} + H_{N-1}\xi_{N-1}` et sa covariance, tous de la dernière
+    itération (n points).
     """
 
     T: np.ndarray
@@ -83,29 +110,64 @@ class SE3Update(NamedTuple):
     innovation: np.ndarray
 
 
-@dataclass(frozen=True, eq=False)
-class SE3FilterResult:
-    r"""Sortie de :func:`se3_iterated_filter` sur ``F`` images (temps en premier).
+@dataclass(frozen=True, eq=False, repr=False)
+class SE3FilterResult(FilterResult):
+    r"""Sortie de :func:`se3_iterated_filter` sur ``F`` images : le résultat commun
+    (:class:`~kalman_course.FilterResult`), temps en premier, dont l'estimation est une pose.
 
-    ``T`` (F, 4, 4), ``P`` (F, 6, 6) : a posteriori ; ``T_pred``, ``P_pred`` : prédictions ;
-    ``n_iter`` (F,) : itérations de la correction à chaque image."""
-
-    T: np.ndarray
-    P: np.ndarray
-    T_pred: np.ndarray
-    P_pred: np.ndarray
-    n_iter: np.ndarray
-
-    def __post_init__(self) -> None:
-        freeze_fields(self, "T", "P", "T_pred", "P_pred")
-        n = np.array(self.n_iter, dtype=int, copy=True)
-        n.setflags(write=False)
-        object.__setattr__(self, "n_iter", n)
+    ``x`` (F, 4, 4) (alias ``T``), ``x_pred`` (alias ``T_pred``) : poses a posteriori et prédites ;
+    ``P``, ``P_pred`` (F, 6, 6) : covariances dans l'espace tangent à droite ; ``K`` (F, 6, 2N),
+    ``innovation`` (F, 2N), ``S`` (F, 2N, 2N) : ceux de la dernière linéarisation de chaque correction
+    (les outils de cohérence, NIS et blancheur, s'y appliquent) ; ``observed`` (F, 2N) ; ``n_iter`` (F,)."""
 
     @property
-    def n_steps(self) -> int:
-        """Nombre d'images ``F``."""
-        return self.T.shape[0]
+    def T(self) -> np.ndarray:
+        """Poses a posteriori (F, 4, 4)."""
+        return self.x
+
+    @property
+    def T_pred(self) -> np.ndarray:
+        """Poses prédites (F, 4, 4)."""
+        return self.x_pred
+
+
+@dataclass(frozen=True, eq=False)
+class CameraPoseModel:
+    r"""Le modèle de l'EKF itéré sur SE(3) : pose :math:`T_{k+1} = T_k\,\mathrm{Exp}(u_k + w_k)`,
+    :math:`w_k \sim \mathcal N(0, Q)`, mesure :math:`y = h(T) + v`, :math:`v \sim \mathcal N(0, \sigma^2 I_{2N})`
+    (pixels des ``N`` points connus ``points`` (N, 3) vus par ``camera``).
+
+    ``sigma_px`` : écart-type du bruit de pixel (px) ; ``Q`` (6, 6) : covariance du bruit d'incrément
+    (``None`` : nulle). ``n_obs`` = 2N, ``n_control`` = 6 (incréments :math:`u_k = [\rho;\theta]`)."""
+
+    points: np.ndarray
+    camera: PinholeCamera
+    sigma_px: float
+    Q: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "points", as_points("points", self.points))
+        object.__setattr__(self, "camera", _check_camera(self.camera))
+        object.__setattr__(self, "sigma_px", _check_sigma(self.sigma_px))
+        Q = np.zeros((6, 6)) if self.Q is None else check_psd("Q", as_square_matrix("Q", self.Q, 6))
+        Q = np.array(Q, dtype=float)
+        Q.setflags(write=False)
+        object.__setattr__(self, "Q", Q)
+
+    @property
+    def n_state(self) -> int:
+        """Dimension de l'espace tangent (6)."""
+        return 6
+
+    @property
+    def n_obs(self) -> int:
+        """Dimension de la mesure (2N)."""
+        return 2 * self.points.shape[0]
+
+    @property
+    def n_control(self) -> int:
+        """Dimension de l'incrément de commande (6)."""
+        return 6
 
 
 # --------------------------------------------------------------------------- vérifications
@@ -132,7 +194,7 @@ def _check_update_inputs(T_pred, P_pred, y, points, camera, sigma_px):
     if y_arr.shape != (2 * pts.shape[0],):
         raise KalmanInputError(
             f"« y » doit empiler les pixels des {pts.shape[0]} points, [u₁, v₁, …, u_N, v_N], forme "
-            f"({2 * pts.shape[0]},) ; reçu la forme {y_arr.shape}."
+            f"({2 * pts.shape[0]},) ; reçu {shape_text(y_arr.shape)}."
         )
     return T, P, y_arr, pts, cam, _check_sigma(sigma_px)
 
@@ -146,39 +208,30 @@ def _cost(T, T_pred_inv, cP, y, points, camera, sigma):
     return 0.5 * float(xi.dot(scipy.linalg.cho_solve(cP, xi))) + 0.5 * float(r.dot(r)) / sigma**2
 
 
-def _iekf(T_pred, P_pred, y, points, camera, sigma, max_iter, tol, use_right_jacobian=True):
+def _linearizer(y, points, camera, sigma, idx=None):
+    r"""``linearize(T_i)`` pour Gauss–Newton : résidu :math:`y - h(T_i)`, jacobienne à droite, :math:`R = \sigma^2 I`."""
     R = sigma**2 * np.eye(y.size)
-    T_pred_inv = _se3_inverse(T_pred)
-    cP = scipy.linalg.cho_factor(P_pred, lower=True)
-    T_i = T_pred
-    iterates, xis, steps, costs = [T_pred], [], [], []
-    converged = False
-    nu0 = None
-    for _ in range(max_iter):
-        xi = _se3_log(T_pred_inv @ T_i)
-        J = _se3_jl(-xi) if use_right_jacobian else np.eye(6)
-        P_i = _symmetrize(J @ P_pred @ J.T)
+
+    def linearize(T_i):
+        h = _measure(T_i, points, camera)
         H = _measurement_jacobian(T_i, points, camera, "right")
-        r = y - _measure(T_i, points, camera)
-        if nu0 is None:
-            nu0 = r
-        xis.append(xi)
-        costs.append(_cost(T_i, T_pred_inv, cP, y, points, camera, sigma))
-        # correction linéaire de l'a priori δ ~ N(−ξ_i, P_i) par la « mesure » r_i + H_i ξ_i
-        delta, P_post, K, S = _correct(-xi, P_i, r + H @ xi, H, R, False)
-        T_i = T_i @ _se3_exp(delta)
-        iterates.append(T_i)
-        steps.append(delta)
-        if float(np.linalg.norm(delta)) < tol:
-            converged = True
-            break
-    xis.append(_se3_log(T_pred_inv @ T_i))
-    costs.append(_cost(T_i, T_pred_inv, cP, y, points, camera, sigma))
-    Jd = _se3_jl(-delta)  # transport de l'espace tangent en T_{N-1} vers T_N : J_r(δ_{N-1})
-    P_plus = _symmetrize(Jd @ P_post @ Jd.T)
+        if idx is not None:
+            h, H = h[idx], H[idx]
+        return y - h, H, R
+
+    return linearize
+
+
+def _iekf(T_pred, P_pred, y, points, camera, sigma, max_iter, tol, use_right_jacobian=True):
+    space = SE3_SPACE if use_right_jacobian else StateSpace(_se3_oplus, _se3_ominus, None, _transport)
+    c = gauss_newton_update(T_pred, P_pred, _linearizer(y, points, camera, sigma), space, max_iter, tol)
+    T_pred_inv = _se3_inverse(T_pred)
+    cP = (cholesky_factor(P_pred, "P_pred", "définie positive pour évaluer le coût MAP"), True)
+    xis = np.array([_se3_log(T_pred_inv @ T_i) for T_i in c.iterates])
+    costs = np.array([_cost(T_i, T_pred_inv, cP, y, points, camera, sigma) for T_i in c.iterates])
     return SE3Update(
-        T=T_i, P=P_plus, n_iter=len(steps), converged=converged, iterates=np.array(iterates),
-        xi=np.array(xis), steps=np.array(steps), cost=np.array(costs), K=K, S=S, innovation=nu0,
+        T=c.x, P=c.P, n_iter=c.n_iter, converged=c.converged, iterates=c.iterates,
+        xi=xis, steps=c.steps, cost=costs, K=c.K, S=c.S, innovation=c.innovation,
     )
 
 
@@ -204,7 +257,7 @@ def se3_predict(T: Any, P: Any, u: Any, Q: Any) -> SE3Prediction:
     E = _se3_exp(u)
     F = _se3_adjoint(_se3_inverse(E))
     G = _se3_jl(-u)
-    return SE3Prediction(T @ E, _symmetrize(F @ P @ F.T + G @ Q @ G.T))
+    return SE3Prediction(T @ E, symmetrize(F @ P @ F.T + G @ Q @ G.T))
 
 
 def se3_iekf_update(
@@ -242,7 +295,7 @@ def se3_iekf_update(
     (:class:`~kalman_course.camera.PinholeCamera`), ``sigma_px`` (px).
     Renvoie :class:`SE3Update` (pose, covariance, nombre d'itérations et historique).
     """
-    max_iter, tol = _check_iterations(max_iter, tol)
+    max_iter, tol = check_iterations(max_iter, tol)
     T, P, y_arr, pts, cam, sigma = _check_update_inputs(T_pred, P_pred, y, points, camera, sigma_px)
     return _iekf(T, P, y_arr, pts, cam, sigma, max_iter, tol, bool(use_right_jacobian))
 
@@ -287,35 +340,42 @@ def se3_iterated_filter(
     Paramètres : ``y`` (F, 2n) pixels ; ``T0`` (4, 4), ``P0`` (6, 6) : estimation avant la première image ;
     ``u`` (F, 6) incréments connus (``None`` : nuls) ; ``Q`` (6, 6) bruit d'incrément (``None`` : nul).
     """
-    max_iter, tol = _check_iterations(max_iter, tol)
-    pts = as_points("points", points)
-    Y = as_float_array("y", y)
-    if Y.ndim != 2 or Y.shape[1] != 2 * pts.shape[0] or Y.shape[0] == 0:
-        raise KalmanInputError(
-            f"« y » doit être de forme (F, {2 * pts.shape[0]}) : une ligne de pixels par image ; "
-            f"reçu la forme {Y.shape}."
-        )
-    F_steps = Y.shape[0]
-    if u is None:
-        U = np.zeros((F_steps, 6))
-    else:
-        U = as_float_array("u", u)
-        if U.shape != (F_steps, 6):
-            raise KalmanInputError(f"« u » doit être de forme ({F_steps}, 6) ; reçu la forme {U.shape}.")
-    Qm = np.zeros((6, 6)) if Q is None else check_psd("Q", as_square_matrix("Q", Q, 6))
-    T = as_pose("T0", T0)
-    P = check_psd("P0", as_square_matrix("P0", P0, 6))
-    cam = _check_camera(camera)
-    sigma = _check_sigma(sigma_px)
-    out_T, out_P, out_Tp, out_Pp, n_iter = [], [], [], [], []
-    for k in range(F_steps):
-        Tp, Pp = se3_predict(T, P, U[k], Qm)
-        res = _iekf(Tp, check_pd("P_pred", Pp), Y[k], pts, cam, sigma, max_iter, tol)
-        T, P = res.T, res.P
-        out_T.append(T)
-        out_P.append(P)
-        out_Tp.append(Tp)
-        out_Pp.append(Pp)
-        n_iter.append(res.n_iter)
-    return SE3FilterResult(T=np.array(out_T), P=np.array(out_P), T_pred=np.array(out_Tp),
-                           P_pred=np.array(out_Pp), n_iter=np.array(n_iter))
+    model = CameraPoseModel(points, camera, sigma_px, Q)
+    return run_filter(se3_family(max_iter, tol), model, y, T0, P0, u)
+
+
+def _pose_prior(model: CameraPoseModel, T0: Any, P0: Any):
+    return as_pose("T0", T0), check_psd("P0", as_square_matrix("P0", P0, 6))
+
+
+def se3_family(max_iter: int = DEFAULT_MAX_ITER, tol: float = DEFAULT_TOL) -> FilterFamily:
+    r"""Les étapes de l'EKF itéré sur SE(3) pour le moteur (état interne :math:`(\hat T, P)`)."""
+    max_iter, tol = check_iterations(max_iter, tol)
+
+    def predict_step(model: CameraPoseModel, state, u):
+        T, P = state
+        if u is None:
+            return T, symmetrize(P + model.Q)
+        E = _se3_exp(u)
+        F = _se3_adjoint(_se3_inverse(E))
+        G = _right_jacobian(u)
+        return T @ E, symmetrize(F @ P @ F.T + G @ model.Q @ G.T)
+
+    def update_step(model: CameraPoseModel, state, y, idx):
+        T_pred, P_pred = state
+        linearize = _linearizer(y, model.points, model.camera, model.sigma_px, idx)
+        c = gauss_newton_update(T_pred, P_pred, linearize, SE3_SPACE, max_iter, tol)
+        return (c.x, c.P), Correction(c.K, c.innovation, c.S, c.n_iter)
+
+    return FilterFamily(
+        name="EKF itéré sur SE(3)",
+        model_type=CameraPoseModel,
+        model_hint="construisez-le avec CameraPoseModel(points, camera, sigma_px, Q)",
+        prior=_pose_prior,
+        predict=predict_step,
+        update=update_step,
+        moments=lambda state: state,
+        result_type=SE3FilterResult,
+        state_shape=lambda model: (4, 4),
+        tangent_dim=lambda model: 6,
+    )

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from .validation import KalmanInputError, as_float_array, as_vector
+from ..core.validation import KalmanInputError, as_float_array, as_vector, shape_text
 
 __all__ = [
     "hat3",
@@ -74,7 +74,7 @@ def as_rotation(name: str, value: Any) -> np.ndarray:
     r"""Matrice de rotation (3, 3) : :math:`R^TR = I` et :math:`\det R = +1` (à :data:`ROTATION_TOL` près)."""
     R = as_float_array(name, value)
     if R.shape != (3, 3):
-        raise KalmanInputError(f"« {name} » doit être une matrice de rotation (3, 3) ; reçu la forme {R.shape}.")
+        raise KalmanInputError(f"« {name} » doit être une matrice de rotation (3, 3) ; reçu {shape_text(R.shape)}.")
     err = float(np.max(np.abs(R.T @ R - np.eye(3))))
     det = float(np.linalg.det(R))
     if err > ROTATION_TOL or abs(det - 1.0) > ROTATION_TOL:
@@ -90,7 +90,7 @@ def as_pose(name: str, value: Any) -> np.ndarray:
     T = as_float_array(name, value)
     if T.shape != (4, 4):
         raise KalmanInputError(
-            f"« {name} » doit être une transformation rigide (4, 4) de SE(3) ; reçu la forme {T.shape}."
+            f"« {name} » doit être une transformation rigide (4, 4) de SE(3) ; reçu {shape_text(T.shape)}."
         )
     if np.max(np.abs(T[3] - [0.0, 0.0, 0.0, 1.0])) > ROTATION_TOL:
         raise KalmanInputError(
@@ -121,7 +121,7 @@ def vee3(W: Any) -> np.ndarray:
     r"""Inverse de :func:`hat3` : :math:`([w]_\times)^\vee = w` (3,) (partie antisymétrique de ``W``)."""
     W = as_float_array("W", W)
     if W.shape != (3, 3):
-        raise KalmanInputError(f"« W » doit être une matrice (3, 3) ; reçu la forme {W.shape}.")
+        raise KalmanInputError(f"« W » doit être une matrice (3, 3) ; reçu {shape_text(W.shape)}.")
     return 0.5 * np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]])
 
 
@@ -139,7 +139,7 @@ def vee(X: Any) -> np.ndarray:
     r"""Inverse de :func:`hat` : :math:`(\xi^\wedge)^\vee = [\rho;\theta]` (6,)."""
     X = as_float_array("X", X)
     if X.shape != (4, 4):
-        raise KalmanInputError(f"« X » doit être une matrice (4, 4) de se(3) ; reçu la forme {X.shape}.")
+        raise KalmanInputError(f"« X » doit être une matrice (4, 4) de se(3) ; reçu {shape_text(X.shape)}.")
     return np.concatenate([X[:3, 3], vee3(X[:3, :3])])
 
 

@@ -27,8 +27,8 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from .models import LinearGaussianModel
-from .validation import (
+from ..core.models import LinearGaussianModel
+from ..core.validation import (
     KalmanInputError,
     as_controls,
     as_float_array,

@@ -34,9 +34,9 @@ from typing import Any
 
 import numpy as np
 
-from .jacobians import JacobianCheck, numerical_jacobian
+from ..core.jacobians import JacobianCheck, numerical_jacobian
 from .lie import _se3_exp, as_pose, hat3
-from .validation import KalmanInputError, as_float_array
+from ..core.validation import KalmanInputError, as_float_array, shape_text
 
 __all__ = [
     "PinholeCamera",
@@ -110,7 +110,7 @@ def as_points(name: str, points: Any) -> np.ndarray:
     P = as_float_array(name, points)
     if P.ndim != 2 or P.shape[1] != 3 or P.shape[0] == 0:
         raise KalmanInputError(
-            f"« {name} » doit être un tableau de points 3-D de forme (N, 3), N ≥ 1 ; reçu la forme {P.shape}."
+            f"« {name} » doit être un tableau de points 3-D de forme (N, 3), N ≥ 1 ; reçu {shape_text(P.shape)}."
         )
     return P
 
@@ -242,7 +242,7 @@ def check_camera_jacobian(
     Jn = numerical_jacobian(_retracted_measurement(T, pts, cam, perturbation), np.zeros(6), step=step,
                             name=f"h(T ⊕ δ) ({perturbation})")
     if Ja.shape != Jn.shape:
-        raise KalmanInputError(f"« jacobian » doit être de forme {Jn.shape} ; reçu la forme {Ja.shape}.")
+        raise KalmanInputError(f"« jacobian » doit être de forme {Jn.shape} ; reçu {shape_text(Ja.shape)}.")
     diff = np.abs(Ja - Jn)
     worst = np.unravel_index(int(np.argmax(diff)), diff.shape)
     max_abs = float(diff.max())

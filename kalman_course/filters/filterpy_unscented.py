@@ -12,10 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from .ekf import _check_model
-from .kf import _check_state
-from .results import FilterResult
-from .validation import KalmanInputError, as_controls, as_measurements
+from ..core.results import FilterResult
+from ..core.validation import KalmanInputError, as_controls, as_gaussian, as_measurements
+from .extended import check_model
 
 __all__ = ["filterpy_unscented_filter"]
 
@@ -46,7 +45,7 @@ def filterpy_unscented_filter(
     """
     from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 
-    model = _check_model(model)
+    model = check_model(model)
     if model.f_noise_jacobian is not None or model.h_noise_jacobian is not None:
         raise KalmanInputError(
             "L'UKF de filterpy suppose des bruits additifs : le modèle ne doit pas avoir de "
@@ -56,7 +55,7 @@ def filterpy_unscented_filter(
     Y = as_measurements("y", y, m)
     T = Y.shape[0]
     U = as_controls("u", u, T, model.n_control)
-    x, P = _check_state(x0, P0, n, "x0", "P0")
+    x, P = as_gaussian(x0, P0, n, "x0", "P0")
     observed = ~np.isnan(Y)
     partial = observed.any(axis=1) & ~observed.all(axis=1)
     if partial.any():

@@ -20,7 +20,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .validation import KalmanInputError, as_vector, call_user_function, check_finite_output
+from .validation import KalmanInputError, as_vector, call_user_function, check_finite_output, shape_text
 
 __all__ = ["JacobianCheck", "numerical_jacobian", "check_jacobian", "wrap_angle"]
 
@@ -72,7 +72,7 @@ def numerical_jacobian(
     """
     x = np.asarray(x, dtype=float)
     if x.ndim != 1:
-        raise KalmanInputError(f"« x » doit être un vecteur 1-D ; reçu la forme {x.shape}.")
+        raise KalmanInputError(f"« x » doit être un vecteur 1-D ; reçu {shape_text(x.shape)}.")
     rel = CENTRAL_STEP if step is None else float(step)
     if not rel > 0:
         raise KalmanInputError(f"« step » doit être strictement positif ; reçu {step!r}.")

@@ -14,24 +14,15 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from .models import LinearGaussianModel
-from .results import FilterHistory, FilterResult
-from .validation import (
-    KalmanInputError,
-    as_controls,
-    as_measurements,
-    as_square_matrix,
-    as_vector,
-    check_control_allowed,
-    check_instance,
-    check_psd,
-)
+from ..core.linalg import correct, symmetrize
+from ..core.models import LinearGaussianModel
+from ..core.results import FilterResult
+from ..core.validation import as_gaussian, as_vector, check_control_allowed
+from .engine import Correction, FilterFamily, gaussian_moments, gaussian_prior, run_filter
 
-__all__ = ["Prediction", "Update", "predict", "update", "kalman_filter", "recipe_step"]
-
-# Résolution de S X = B par Cholesky (LAPACK ?posv, via scipy.linalg) : S n'est jamais inversée,
-# et l'échec de la factorisation signale une covariance d'innovation non définie positive.
-_posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
+__all__ = [
+    "Prediction", "Update", "predict", "update", "kalman_filter", "kalman_family", "kalman_filter_runs", "recipe_step",
+]
 
 
 class Prediction(NamedTuple):
@@ -58,53 +49,17 @@ class Update(NamedTuple):
 # --------------------------------------------------------------------------- noyaux internes
 
 
-# Les noyaux écrivent ``A.dot(P)`` plutôt que ``A @ P`` : même calcul, mais trois fois moins de
-# surcoût par appel sur de petites matrices (voir benchmarks/).
-
-
-def _symmetrize(P: np.ndarray) -> np.ndarray:
-    """Partie symétrique :math:`(P + P^T)/2` (efface l'asymétrie due aux arrondis)."""
-    P = P + P.T.copy()
-    P *= 0.5
-    return P
-
-
 def _predict(x: np.ndarray, P: np.ndarray, A: np.ndarray, Q: np.ndarray, Bu: np.ndarray | None):
+    # ``A.dot(P)`` plutôt que ``A @ P`` : même calcul, trois fois moins de surcoût par appel sur de
+    # petites matrices (voir benchmarks/).
     x_pred = A.dot(x)
     if Bu is not None:
         x_pred += Bu
-    return x_pred, _symmetrize(A.dot(P).dot(A.T) + Q)
-
-
-def _gain(P_pred: np.ndarray, C: np.ndarray, R: np.ndarray):
-    """Gain :math:`K = P^- C^T S^{-1}` par résolution de Cholesky ; renvoie ``(K, S, PCt)``."""
-    PCt = P_pred.dot(C.T)
-    S = C.dot(PCt) + R
-    _, Kt, info = _posv(S, PCt.T)
-    if info != 0:
-        raise KalmanInputError(
-            "La covariance d'innovation « S = C P⁻ Cᵀ + R » n'est pas définie positive (singulière "
-            "numériquement) : vérifiez les ordres de grandeur de P0, Q et R."
-        )
-    return Kt.T, S, PCt
-
-
-def _correct(x_pred, P_pred, nu, C, R, joseph: bool):
-    """Correction commune au KF et à l'EKF (``C`` est la jacobienne pour l'EKF)."""
-    K, S, PCt = _gain(P_pred, C, R)
-    x = x_pred + K.dot(nu)
-    if joseph:
-        IKC = np.eye(P_pred.shape[0]) - K.dot(C)
-        P = IKC.dot(P_pred).dot(IKC.T) + K.dot(R).dot(K.T)
-    else:
-        P = P_pred - K.dot(PCt.T)
-    return x, _symmetrize(P), K, S
+    return x_pred, symmetrize(A.dot(P).dot(A.T) + Q)
 
 
 def _check_state(x: Any, P: Any, n: int, x_name: str, P_name: str):
-    x_arr = as_vector(x_name, x, n)
-    P_arr = check_psd(P_name, as_square_matrix(P_name, P, n))
-    return x_arr, P_arr
+    return as_gaussian(x, P, n, x_name, P_name)
 
 
 def _control_term(model: LinearGaussianModel, u: Any) -> np.ndarray | None:
@@ -160,7 +115,7 @@ def update(model: LinearGaussianModel, x_pred: Any, P_pred: Any, y: Any, joseph:
     x_arr, P_arr = _check_state(x_pred, P_pred, model.n_state, "x_pred", "P_pred")
     y_arr = as_vector("y", y, model.n_obs)
     nu = y_arr - model.C @ x_arr
-    x, P, K, S = _correct(x_arr, P_arr, nu, model.C, model.R, joseph)
+    x, P, K, S = correct(x_arr, P_arr, nu, model.C, model.R, joseph)
     return Update(x, P, K, nu, S)
 
 
@@ -225,32 +180,33 @@ def kalman_filter(
         ``x`` (T, n), ``P`` (T, n, n), ``x_pred``, ``P_pred``, ``K`` (T, n, m), ``innovation`` (T, m),
         ``S`` (T, m, m), ``observed`` (T, m).
     """
-    check_instance("model", model, LinearGaussianModel)
-    n, m = model.n_state, model.n_obs
-    Y = as_measurements("y", y, m)
-    T = Y.shape[0]
-    U = as_controls("u", u, T, model.n_control)
-    x, P = _check_state(x0, P0, n, "x0", "P0")
+    return run_filter(kalman_family(joseph), model, y, x0, P0, u)
 
-    A, C, Q, R = model.A, model.C, model.Q, model.R
-    BU = None if U is None else U @ model.B.T  # (T, n)
-    observed = ~np.isnan(Y)
-    all_observed = bool(observed.all())
-    out = FilterHistory(T, n, m, observed)
 
-    for k in range(T):
-        x_pred, P_pred = _predict(x, P, A, Q, None if BU is None else BU[k])
-        if all_observed or observed[k].all():
-            nu = Y[k] - C.dot(x_pred)
-            x, P, K, S = _correct(x_pred, P_pred, nu, C, R, joseph)
-            out.correction(k, K, nu, S)
-        elif observed[k].any():
-            idx = np.flatnonzero(observed[k])
-            C_k = C[idx]
-            nu = Y[k, idx] - C_k.dot(x_pred)
-            x, P, K, S = _correct(x_pred, P_pred, nu, C_k, R[np.ix_(idx, idx)], joseph)
-            out.correction(k, K, nu, S, idx)
+def kalman_family(joseph: bool = False) -> FilterFamily:
+    r"""Les étapes du filtre de Kalman linéaire pour le moteur :func:`~kalman_course.filters.engine.run_filter`
+    (état interne :math:`(\hat x, P)`)."""
+
+    def predict_step(model: LinearGaussianModel, state, u):
+        x, P = state
+        return _predict(x, P, model.A, model.Q, None if u is None else model.B.dot(u))
+
+    def update_step(model: LinearGaussianModel, state, y, idx):
+        x_pred, P_pred = state
+        if idx is None:
+            C, R = model.C, model.R
         else:
-            x, P = x_pred, P_pred
-        out.store(k, x_pred, P_pred, x, P)
-    return out.result()
+            C, R = model.C[idx], model.R[np.ix_(idx, idx)]
+        nu = y - C.dot(x_pred)
+        x, P, K, S = correct(x_pred, P_pred, nu, C, R, joseph)
+        return (x, P), Correction(K, nu, S)
+
+    return FilterFamily(
+        name="filtre de Kalman",
+        model_type=LinearGaussianModel,
+        model_hint="pour un modèle non linéaire, utilisez extended_kalman_filter",
+        prior=gaussian_prior,
+        predict=predict_step,
+        update=update_step,
+        moments=gaussian_moments,
+    )

@@ -14,6 +14,7 @@ import scipy.linalg
 
 __all__ = [
     "KalmanInputError",
+    "shape_text",
     "as_float_array",
     "as_vector",
     "as_matrix",
@@ -21,6 +22,7 @@ __all__ = [
     "check_symmetric",
     "check_psd",
     "check_pd",
+    "as_gaussian",
     "symmetric_tolerance",
     "as_measurements",
     "as_controls",
@@ -35,10 +37,12 @@ class KalmanInputError(ValueError):
     """Entrée invalide : le message (en français) nomme l'argument et ce qui était attendu."""
 
 
-def _shape_text(shape: tuple[int, ...]) -> str:
+def shape_text(shape: tuple[int, ...]) -> str:
+    """La forme d'un tableau reçu, pour un message : « un scalaire », « la forme (2,) », « la forme (3, 4) »."""
+    shape = tuple(int(s) for s in shape)
     if len(shape) == 0:
         return "un scalaire"
-    return "(" + ", ".join(str(s) for s in shape) + ")"
+    return f"la forme {shape}"
 
 
 def as_float_array(name: str, value: Any, *, allow_nan: bool = False) -> np.ndarray:
@@ -77,7 +81,7 @@ def as_vector(name: str, value: Any, n: int) -> np.ndarray:
     if arr.shape != (n,):
         hint = " (vecteur colonne : utilisez un tableau 1-D, par exemple x.ravel())" if arr.shape == (n, 1) else ""
         raise KalmanInputError(
-            f"« {name} » doit être un vecteur de forme ({n},) ; reçu la forme {_shape_text(arr.shape)}{hint}."
+            f"« {name} » doit être un vecteur de forme ({n},) ; reçu {shape_text(arr.shape)}{hint}."
         )
     return arr
 
@@ -93,14 +97,14 @@ def as_matrix(
     expected = f"({rows if rows is not None else free_rows}, {cols if cols is not None else free_cols})"
     if arr.ndim != 2:
         raise KalmanInputError(
-            f"« {name} » doit être une matrice 2-D de forme {expected} ; reçu la forme {_shape_text(arr.shape)}."
+            f"« {name} » doit être une matrice 2-D de forme {expected} ; reçu {shape_text(arr.shape)}."
         )
     if (rows is not None and arr.shape[0] != rows) or (cols is not None and arr.shape[1] != cols):
         raise KalmanInputError(
-            f"« {name} » doit être de forme {expected} ; reçu la forme {_shape_text(arr.shape)}."
+            f"« {name} » doit être de forme {expected} ; reçu {shape_text(arr.shape)}."
         )
     if arr.shape[0] == 0 or arr.shape[1] == 0:
-        raise KalmanInputError(f"« {name} » est vide (forme {_shape_text(arr.shape)}).")
+        raise KalmanInputError(f"« {name} » est vide ({shape_text(arr.shape)}).")
     return arr
 
 
@@ -112,11 +116,11 @@ def as_square_matrix(name: str, value: Any, n: int | None) -> np.ndarray:
     if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
         size = "n" if n is None else str(n)
         raise KalmanInputError(
-            f"« {name} » doit être une matrice carrée ({size}, {size}) ; reçu la forme {_shape_text(arr.shape)}."
+            f"« {name} » doit être une matrice carrée ({size}, {size}) ; reçu {shape_text(arr.shape)}."
         )
     if n is not None and arr.shape[0] != n:
         raise KalmanInputError(
-            f"« {name} » doit être de forme ({n}, {n}) ; reçu la forme {_shape_text(arr.shape)}."
+            f"« {name} » doit être de forme ({n}, {n}) ; reçu {shape_text(arr.shape)}."
         )
     if arr.shape[0] == 0:
         raise KalmanInputError(f"« {name} » est vide.")
@@ -165,6 +169,11 @@ def check_pd(name: str, M: np.ndarray) -> np.ndarray:
     return M
 
 
+def as_gaussian(x: Any, P: Any, n: int, x_name: str = "x0", P_name: str = "P0") -> tuple[np.ndarray, np.ndarray]:
+    """Une estimation gaussienne : ``x`` vecteur (n,), ``P`` covariance (n, n) symétrique semi-définie positive."""
+    return as_vector(x_name, x, n), check_psd(P_name, as_square_matrix(P_name, P, n))
+
+
 def as_measurements(name: str, y: Any, m: int) -> np.ndarray:
     """Mesures empilées ``(T, m)`` ; ``(T,)`` accepté si ``m = 1``.
 
@@ -181,7 +190,7 @@ def as_measurements(name: str, y: Any, m: int) -> np.ndarray:
         extra = " ou (T,)" if m == 1 else ""
         raise KalmanInputError(
             f"« {name} » doit être de forme (T, {m}){extra} : une ligne de {m} composante(s) par pas de temps ; "
-            f"reçu la forme {_shape_text(arr.shape)}."
+            f"reçu {shape_text(arr.shape)}."
         )
     if arr.shape[0] == 0:
         raise KalmanInputError(f"« {name} » ne contient aucune mesure (T = 0).")
@@ -202,7 +211,7 @@ def as_controls(name: str, u: Any, n_steps: int, p: int) -> np.ndarray | None:
     if arr.ndim != 2 or arr.shape[1] != p:
         extra = " ou (T,)" if p == 1 else ""
         raise KalmanInputError(
-            f"« {name} » doit être de forme (T, {p}){extra} ; reçu la forme {_shape_text(arr.shape)}."
+            f"« {name} » doit être de forme (T, {p}){extra} ; reçu {shape_text(arr.shape)}."
         )
     if arr.shape[0] != n_steps:
         raise KalmanInputError(

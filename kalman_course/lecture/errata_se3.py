@@ -1,6 +1,6 @@
 r"""Les formules des notes « IEKF sur SE(3) » **telles qu'écrites** (fausses), pour montrer les errata 004-*.
 
-Ne pas utiliser pour filtrer : la forme correcte est :func:`kalman_course.manifold.se3_iekf_update`.
+Ne pas utiliser pour filtrer : la forme correcte est :func:`kalman_course.se3_filter.se3_iekf_update`.
 
 * :func:`notes_residual` — erratum 004-2 : :math:`e = [u - f_xX'/Z' + c_x;\ v - f_yY'/Z' + c_y]` (signe de
   :math:`c_x, c_y`).
@@ -23,12 +23,12 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from .camera import PinholeCamera, _check_camera, _measure, _measurement_jacobian, _transform, as_points
-from .ekf import _check_iterations
-from .kf import _gain
-from .lie import _se3_exp, _se3_inverse, _se3_jl_inv, _se3_log, as_pose
-from .manifold import _check_update_inputs
-from .validation import KalmanInputError
+from ..geometry.camera import PinholeCamera, _check_camera, _measure, _measurement_jacobian, _transform, as_points
+from ..core.linalg import kalman_gain
+from ..filters.iteration import DEFAULT_MAX_ITER, DEFAULT_TOL, iterate
+from ..geometry.lie import _se3_exp, _se3_inverse, _se3_jl_inv, _se3_log, as_pose
+from ..se3_filter import _check_update_inputs
+from ..core.validation import KalmanInputError
 
 __all__ = [
     "notes_residual",
@@ -78,24 +78,20 @@ def notes_residual_jacobian(P_cam: Any, camera: PinholeCamera, restore_missing: 
 
 def notes_literal_iterates(
     T_pred: Any, P_pred: Any, y: Any, points: Any, camera: PinholeCamera, sigma_px: float,
-    max_iter: int = 200, tol: float = 1e-10,
+    max_iter: int = DEFAULT_MAX_ITER, tol: float = DEFAULT_TOL,
 ) -> np.ndarray:
     r"""Boucle des notes (l. 58–64), inverse du gain rétablie (004-8) et « + » lu comme :math:`\oplus` :
     :math:`T_{i+1} = T_i\,\mathrm{Exp}\big(K_i(y - h(T_i))\big)`, :math:`K_i = P_-H_i^T(H_iP_-H_i^T + R)^{-1}`.
     Renvoie les itérés (N+1, 4, 4)."""
-    max_iter, tol = _check_iterations(max_iter, tol)
     T, P, y_arr, pts, cam, sigma = _check_update_inputs(T_pred, P_pred, y, points, camera, sigma_px)
     R = sigma**2 * np.eye(y_arr.size)
-    its = [T]
-    for _ in range(max_iter):
-        H = _measurement_jacobian(T, pts, cam, "right")
-        K, _, _ = _gain(P, H, R)
-        d = K @ (y_arr - _measure(T, pts, cam))
-        T = T @ _se3_exp(d)
-        its.append(T)
-        if float(np.linalg.norm(d)) < tol:
-            break
-    return np.array(its)
+
+    def step(T_i):
+        K = kalman_gain(P, _measurement_jacobian(T_i, pts, cam, "right"), R)[0]
+        d = K @ (y_arr - _measure(T_i, pts, cam))
+        return T_i @ _se3_exp(d), float(np.linalg.norm(d)), None
+
+    return iterate(T, step, max_iter, tol).iterates
 
 
 def embedded_step(

@@ -28,12 +28,10 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from .models import LinearGaussianModel, NonlinearModel
-from .results import FilterHistory, FilterResult
-from .validation import (
+from ..core.models import LinearGaussianModel, NonlinearModel
+from ..core.results import FilterResult
+from ..core.validation import (
     KalmanInputError,
-    as_controls,
-    as_measurements,
     as_square_matrix,
     as_vector,
     check_control_allowed,
@@ -41,6 +39,8 @@ from .validation import (
     check_psd,
     check_instance,
 )
+from .engine import Correction, FilterFamily, run_filter
+from .extended import linearize_observation
 
 __all__ = [
     "SquareRootInformation",
@@ -164,14 +164,14 @@ def _triangularize(pre: np.ndarray) -> np.ndarray:
     return scipy.linalg.qr(pre, mode="r", check_finite=False)[0]
 
 
-def _time_update_inverse(R, z, A, G, c):
+def _time_update_inverse(R, z, lu, G, c):
     r"""Prédiction § 4.2 : QR de :math:`\begin{bmatrix} I_q & 0 & 0\\ -\mathcal R A^{-1}\Gamma & \mathcal R A^{-1} & z + \mathcal R A^{-1}c\end{bmatrix}`.
 
-    ``c`` (n,) ou ``None`` : terme forcé :math:`x_{k+1} = Ax_k + c + \Gamma v` (:math:`Bu`, ou
-    :math:`f(\hat x) - F\hat x` pour le filtre étendu).
+    ``lu`` : factorisation LU de :math:`A` (:func:`_lu_invertible`, calculée une fois par passage quand
+    :math:`A` est constante) ; ``c`` (n,) ou ``None`` : terme forcé :math:`x_{k+1} = Ax_k + c + \Gamma v`
+    (:math:`Bu`, ou :math:`f(\hat x) - F\hat x` pour le filtre étendu).
     """
-    n, q = A.shape[0], G.shape[1]
-    lu = _lu_invertible(A)
+    n, q = G.shape
     RAinv = scipy.linalg.lu_solve(lu, R.T, trans=1, check_finite=False).T  # X A = R  ⇔  Aᵀ Xᵀ = Rᵀ
     pre = np.zeros((q + n, q + n + 1))
     pre[:q, :q] = np.eye(q)
@@ -182,13 +182,21 @@ def _time_update_inverse(R, z, A, G, c):
     return (*_positive_diagonal(post[q:, q:q + n], post[q:, -1]), _norm(pre[q:, :-1]))
 
 
-def _lu_invertible(A: np.ndarray):
+def _lu_invertible(A: np.ndarray, name: str = "A"):
+    """Factorisation LU de la transition, après avoir vérifié qu'elle est inversible (la prédiction des
+    notes utilise :math:`A^{-1}`). ``name="F"`` : jacobienne du SRIF étendu, évaluée à chaque pas."""
     sv = scipy.linalg.svdvals(A)
     if sv[-1] <= A.shape[0] * np.finfo(float).eps * sv[0]:
+        cond = f"conditionnement {sv[0] / max(sv[-1], 1e-300):.3g}"
+        if name == "A":
+            raise KalmanInputError(
+                f"La matrice de transition « A » (F des notes) est singulière ({cond}) : la prédiction du "
+                "SRIF sous la forme des notes utilise A⁻¹. Utilisez method=\"joint\" (forme sans A⁻¹, qui "
+                "demande un bruit d'état Q défini positif)."
+            )
         raise KalmanInputError(
-            "La matrice de transition « A » (F des notes) est singulière (conditionnement "
-            f"{sv[0] / max(sv[-1], 1e-300):.3g}) : la prédiction du SRIF sous la forme des notes utilise A⁻¹. "
-            "Utilisez method=\"joint\" (forme sans A⁻¹, qui demande un bruit d'état Q défini positif)."
+            f"La jacobienne « F » = ∂f/∂x de la transition est singulière en l'estimation courante ({cond}) : "
+            "la prédiction du SRIF étendu utilise F⁻¹. Utilisez extended_kalman_filter pour ce modèle."
         )
     return scipy.linalg.lu_factor(A, check_finite=False)
 
@@ -357,7 +365,7 @@ def srif_predict(model: LinearGaussianModel, R: Any, z: Any, u: Any = None,
         check_control_allowed("u", model.n_control)
         c = model.B @ as_vector("u", u, model.n_control)
     if method == "inverse":
-        R_new, z_new, _ = _time_update_inverse(R_arr, z_arr, model.A, noise_factor(model.Q), c)
+        R_new, z_new, _ = _time_update_inverse(R_arr, z_arr, _lu_invertible(model.A), noise_factor(model.Q), c)
     else:
         R_new, z_new, _ = _time_update_joint(R_arr, z_arr, model.A, _joint_factor(model.Q), c)
     return SquareRootInformation(R_new, z_new)
@@ -406,26 +414,45 @@ def _initial_information(n: int, x0: Any, P0: Any, R0: Any, z0: Any):
     return SquareRootInformation(np.zeros((n, n)), np.zeros(n))
 
 
-def _record(out: FilterHistory, k: int, R_pred, z_pred, R_post, z_post, scales, gain_parts):
-    """Range le pas ``k`` : état et covariance là où l'information est de rang plein, NaN sinon.
-    ``scales`` : normes des pré-tableaux de la prédiction et de la correction (voir :func:`information_rank`)."""
-    n = R_pred.shape[0]
-    prior_ok = information_rank(R_pred, scales[0]) == n
-    post_ok = prior_ok or information_rank(R_post, scales[1]) == n
-    out.x_pred[k], out.P_pred[k] = _state(R_pred, z_pred) if prior_ok else (np.nan, np.nan)
-    out.x[k], out.P[k] = _state(R_post, z_post) if post_ok else (np.nan, np.nan)
-    if gain_parts is None:
-        return
-    H, Rm, nu_fn, idx = gain_parts
-    if prior_ok:
-        # diagnostics du KF équivalent : ν, S = H P⁻ Hᵀ + R, K = P Hᵀ R⁻¹ (forme a posteriori du gain)
-        nu = nu_fn(out.x_pred[k])
-        S = H.dot(out.P_pred[k]).dot(H.T) + Rm
-        K = scipy.linalg.cho_solve(scipy.linalg.cho_factor(Rm, lower=True), H.dot(out.P[k])).T
-        out.correction(k, K, nu, S, idx)
-    else:
-        cols = slice(None) if idx is None else idx
-        out.K[k][:, cols] = np.nan  # a priori singulier : pas de gain de Kalman défini
+class _Information(NamedTuple):
+    """État interne du SRIF dans le moteur : :math:`(\\mathcal R_{xx}, z_x)` et, quand l'information est
+    de rang plein, :math:`(\\hat x, P)` (NaN sinon)."""
+
+    R: np.ndarray
+    z: np.ndarray
+    x: np.ndarray
+    P: np.ndarray
+
+    @property
+    def full(self) -> bool:
+        return bool(np.isfinite(self.x[0]))
+
+
+def _information_state(R: np.ndarray, z: np.ndarray, full: bool) -> _Information:
+    n = R.shape[0]
+    if full:
+        return _Information(R, z, *_state(R, z))
+    return _Information(R, z, np.full(n, np.nan), np.full((n, n), np.nan))
+
+
+def _with_rank(R: np.ndarray, z: np.ndarray, scale: float, already_full: bool = False) -> _Information:
+    """``scale`` : norme du pré-tableau de la dernière QR (voir :func:`information_rank`)."""
+    return _information_state(R, z, already_full or information_rank(R, scale) == R.shape[0])
+
+
+def _diagnostics(prior: _Information, post: _Information, H: np.ndarray, Rm: np.ndarray, nu: np.ndarray) -> Correction:
+    """Diagnostics du KF équivalent : :math:`\\nu`, :math:`S = HP^-H^T + R`, :math:`K = PH^TR^{-1}` (forme a
+    posteriori du gain) ; NaN si l'a priori n'est pas de rang plein (pas de gain de Kalman défini)."""
+    n, m = prior.R.shape[0], H.shape[0]
+    if not prior.full:
+        return Correction(np.full((n, m), np.nan), np.full(m, np.nan), np.full((m, m), np.nan))
+    S = H.dot(prior.P).dot(H.T) + Rm
+    K = scipy.linalg.cho_solve(scipy.linalg.cho_factor(Rm, lower=True), H.dot(post.P)).T
+    return Correction(K, nu, S)
+
+
+def _information_moments(state: _Information):
+    return state.x, state.P
 
 
 def square_root_information_filter(
@@ -464,47 +491,59 @@ def square_root_information_filter(
         définie positive), voir :func:`srif_predict`.
     """
     model = _check_linear(model)
-    method = _check_method(method)
-    n, m = model.n_state, model.n_obs
-    Y = as_measurements("y", y, m)
-    T = Y.shape[0]
-    U = as_controls("u", u, T, model.n_control)
-    R_xx, z_x = _initial_information(n, x0, P0, R0, z0)
+    family = srif_family(model, method)
+    prior = _initial_information(model.n_state, x0, P0, R0, z0)
+    return run_filter(family, model, y, prior, None, u)
 
+
+def srif_family(model: LinearGaussianModel, method: str = "inverse") -> FilterFamily:
+    """Les étapes du SRIF pour le moteur, pour ce ``model`` : les factorisations constantes (LU de
+    :math:`A` ou facteur de Cholesky de :math:`Q`, facteur du bruit d'état, facteur de :math:`R`) sont
+    calculées une seule fois ici, pas à chaque pas. L'a priori passé au moteur est un
+    :class:`SquareRootInformation` (voir :func:`square_root_information_filter`)."""
+    model = _check_linear(model)
+    method = _check_method(method)
     A, C, Rm = model.A, model.C, model.R
-    BU = None if U is None else U @ model.B.T
     if method == "inverse":
-        _lu_invertible(A)
-        G = noise_factor(model.Q)
+        lu, G = _lu_invertible(A), noise_factor(model.Q)
 
         def time_update(R, z, c):
-            return _time_update_inverse(R, z, A, G, c)
+            return _time_update_inverse(R, z, lu, G, c)
     else:
         L = _joint_factor(model.Q)
 
         def time_update(R, z, c):
             return _time_update_joint(R, z, A, L, c)
 
-    observed = ~np.isnan(Y)
-    out = FilterHistory(T, n, m, observed)
     Ra_full = _upper_cholesky("R", Rm)
-    for k in range(T):
-        R_pred, z_pred, scale_pred = time_update(R_xx, z_x, None if BU is None else BU[k])
-        scale_post = scale_pred
-        gain_parts = None
-        if observed[k].any():
-            idx = None if observed[k].all() else np.flatnonzero(observed[k])
-            if idx is None:
-                C_k, R_k, y_k, Ra = C, Rm, Y[k], Ra_full
-            else:
-                C_k, R_k, y_k = C[idx], Rm[np.ix_(idx, idx)], Y[k, idx]
-                Ra = _upper_cholesky("R", R_k)
-            R_xx, z_x, _, scale_post = _measurement_update(R_pred, z_pred, C_k, Ra, y_k)
-            gain_parts = (C_k, R_k, lambda xp, C_k=C_k, y_k=y_k: y_k - C_k.dot(xp), idx)
+
+    def prior(model, info, _):
+        return _with_rank(info.R, info.z, 0.0)
+
+    def predict_step(model, state: _Information, u):
+        R, z, scale = time_update(state.R, state.z, None if u is None else model.B.dot(u))
+        return _with_rank(R, z, scale)
+
+    def update_step(model, state: _Information, y, idx):
+        if idx is None:
+            C_k, R_k, Ra = C, Rm, Ra_full
         else:
-            R_xx, z_x = R_pred, z_pred
-        _record(out, k, R_pred, z_pred, R_xx, z_x, (scale_pred, scale_post), gain_parts)
-    return out.result()
+            C_k, R_k = C[idx], Rm[np.ix_(idx, idx)]
+            Ra = _upper_cholesky("R", R_k)
+        R, z, _, scale = _measurement_update(state.R, state.z, C_k, Ra, y)
+        post = _with_rank(R, z, scale, already_full=state.full)
+        nu = y - C_k.dot(state.x) if state.full else None
+        return post, _diagnostics(state, post, C_k, R_k, nu)
+
+    return FilterFamily(
+        name="filtre d'information en racine carrée",
+        model_type=LinearGaussianModel,
+        model_hint="pour un modèle non linéaire, utilisez extended_square_root_information_filter",
+        prior=prior,
+        predict=predict_step,
+        update=update_step,
+        moments=_information_moments,
+    )
 
 
 # --------------------------------------------------------------------------- SRIF étendu
@@ -523,16 +562,13 @@ def _extended_time_update(model: NonlinearModel, R, z, u):
     x_hat = _require_state(R, z, "l'estimation a posteriori x̂(k)")
     F = model.transition_jacobian(x_hat, u)
     c = model.transition(x_hat, u) - F.dot(x_hat)  # f(x̂) − F x̂ : z + R F⁻¹ c = z + R (F⁻¹ f − x̂)
-    return _time_update_inverse(R, z, F, noise_factor(model.process_noise(x_hat, u), "W Q Wᵀ"), c)[:2]
+    G = noise_factor(model.process_noise(x_hat, u), "W Q Wᵀ")
+    return _time_update_inverse(R, z, _lu_invertible(F, "F"), G, c)[:2]
 
 
 def _extended_measurement_update(model: NonlinearModel, R, z, y, idx):
     x_bar = _require_state(R, z, "la prédiction x̄(k+1)")
-    r = model.residual(y, model.observe(x_bar))  # y − h(x̄), angles ramenés dans (−π, π]
-    H = model.observation_jacobian(x_bar)
-    Rm = model.measurement_noise(x_bar)
-    if idx is not None:
-        r, H, Rm = r[idx], H[idx], Rm[np.ix_(idx, idx)]
+    r, H, Rm = linearize_observation(model, x_bar, y, idx)  # y − h(x̄), angles ramenés dans (−π, π]
     Ra = _upper_cholesky("R", Rm)
     R_new, z_new, zr, _ = _measurement_update(R, z, H, Ra, r + H.dot(x_bar))
     return R_new, z_new, zr, x_bar, H, Rm, r
@@ -576,21 +612,32 @@ def extended_square_root_information_filter(
     (``innovation``, ``S`` et ``K = P H^T R^{-1}`` en diagnostics).
     """
     model = _check_nonlinear(model)
-    n, m = model.n_state, model.n_obs
-    Y = as_measurements("y", y, m)
-    T = Y.shape[0]
-    U = as_controls("u", u, T, model.n_control)
-    R_xx, z_x = _to_information(as_vector("x0", x0, n), as_square_matrix("P0", P0, n), "x0", "P0")
-    observed = ~np.isnan(Y)
-    out = FilterHistory(T, n, m, observed)
-    for k in range(T):
-        R_pred, z_pred = _extended_time_update(model, R_xx, z_x, None if U is None else U[k])
-        gain_parts = None
-        if observed[k].any():
-            idx = None if observed[k].all() else np.flatnonzero(observed[k])
-            R_xx, z_x, _, _, H, Rm, r = _extended_measurement_update(model, R_pred, z_pred, Y[k], idx)
-            gain_parts = (H, Rm, lambda xp, r=r: r, idx)
-        else:
-            R_xx, z_x = R_pred, z_pred
-        _record(out, k, R_pred, z_pred, R_xx, z_x, (0.0, 0.0), gain_parts)
-    return out.result()
+    return run_filter(extended_srif_family(), model, y, x0, P0, u)
+
+
+def extended_srif_family() -> FilterFamily:
+    """Les étapes du SRIF étendu pour le moteur (a priori :math:`(\\hat x_0, P_0)`, :math:`P_0` définie positive)."""
+
+    def prior(model, x0, P0):
+        n = model.n_state
+        R, z = _to_information(as_vector("x0", x0, n), as_square_matrix("P0", P0, n), "x0", "P0")
+        return _information_state(R, z, True)
+
+    def predict_step(model, state: _Information, u):
+        R, z = _extended_time_update(model, state.R, state.z, u)
+        return _information_state(R, z, information_rank(R) == R.shape[0])
+
+    def update_step(model, state: _Information, y, idx):
+        R, z, _, _, H, Rm, r = _extended_measurement_update(model, state.R, state.z, y, idx)
+        post = _information_state(R, z, True)
+        return post, _diagnostics(state, post, H, Rm, r)
+
+    return FilterFamily(
+        name="filtre d'information en racine carrée étendu",
+        model_type=NonlinearModel,
+        model_hint="pour un modèle linéaire, utilisez square_root_information_filter",
+        prior=prior,
+        predict=predict_step,
+        update=update_step,
+        moments=_information_moments,
+    )

@@ -27,12 +27,12 @@ import numpy as np
 import scipy.linalg
 import scipy.stats
 
-from .kf import kalman_filter
-from .models import LinearGaussianModel
-from .results import FilterResult, freeze, freeze_fields
-from .simulate import as_generator, simulate
-from .tables import Table
-from .validation import KalmanInputError, as_controls, as_float_array, as_square_matrix, as_vector, check_pd
+from ..filters.kalman import kalman_filter
+from ..core.models import LinearGaussianModel
+from ..core.results import FilterResult, freeze, freeze_fields
+from ..core.simulation import as_generator, simulate
+from ..tables import Table
+from ..core.validation import KalmanInputError, as_controls, as_float_array, as_square_matrix, as_vector, check_pd, shape_text
 
 __all__ = [
     "ChiSquareTest",
@@ -197,7 +197,7 @@ def nees(x_true: Any, result: FilterResult, *, prior: bool = False) -> np.ndarra
     if x.shape != (T, n):
         raise KalmanInputError(
             f"« x_true » doit être de forme ({T}, {n}) (un état vrai par pas de « result ») ; "
-            f"reçu la forme {x.shape}."
+            f"reçu {shape_text(x.shape)}."
         )
     e = _whiten(x - x_hat, P, np.ones((T, n), dtype=bool), "result.P_pred" if prior else "result.P")
     return np.sum(e * e, axis=1)
@@ -286,7 +286,7 @@ def chi2_mean_test(values: Any, dof: Any, *, level: float = 0.95, quantity: str 
         if d.shape != v.shape:
             raise KalmanInputError(
                 f"« dof » doit être un entier ou un tableau de la forme de « values » {v.shape} ; "
-                f"reçu la forme {d.shape}."
+                f"reçu {shape_text(d.shape)}."
             )
     present = ~np.isnan(v)
     if not present.any():
@@ -344,7 +344,7 @@ def _as_series(name: str, value: Any) -> np.ndarray:
     if arr.ndim != 2 or arr.shape[0] == 0 or arr.shape[1] == 0:
         raise KalmanInputError(
             f"« {name} » doit être une série de forme (T,) ou (T, m), ou un FilterResult ; "
-            f"reçu la forme {arr.shape}."
+            f"reçu {shape_text(arr.shape)}."
         )
     return arr
 

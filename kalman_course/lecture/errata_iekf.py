@@ -20,35 +20,31 @@ from typing import Any
 
 import numpy as np
 
-from .ekf import _check_iterations, _check_model
-from .kf import _check_state, _gain
-from .validation import as_vector
+from ..core.linalg import kalman_gain
+from ..core.validation import as_gaussian, as_vector
+from ..filters.extended import check_model
+from ..filters.iteration import DEFAULT_MAX_ITER, DEFAULT_TOL, iterate
 
 __all__ = ["table_literal_iterates", "no_correction_iterates", "measurement_only_iterates"]
 
 
 def _iterate(model, x_pred, P_pred, y, max_iter, tol, step) -> np.ndarray:
-    model = _check_model(model)
-    max_iter, tol = _check_iterations(max_iter, tol)
-    xp, Pp = _check_state(x_pred, P_pred, model.n_state, "x_pred", "P_pred")
+    """La boucle commune (:func:`~kalman_course.filters.iteration.iterate`) avec le pas ``step`` des notes."""
+    model = check_model(model)
+    xp, Pp = as_gaussian(x_pred, P_pred, model.n_state, "x_pred", "P_pred")
     y_arr = as_vector("y", y, model.n_obs)
     R = model.measurement_noise(xp)
-    x_i = xp
-    iterates = [xp]
-    for _ in range(max_iter):
-        H_i = model.observation_jacobian(x_i)
-        K_i, _, _ = _gain(Pp, H_i, R)
+
+    def one_step(x_i):
+        K_i = kalman_gain(Pp, model.observation_jacobian(x_i), R)[0]
         x_next = step(model, xp, x_i, y_arr, K_i)
-        iterates.append(x_next)
-        done = float(np.linalg.norm(x_next - x_i)) <= tol
-        x_i = x_next
-        if done:
-            break
-    return np.array(iterates)
+        return x_next, float(np.linalg.norm(x_next - x_i)), None
+
+    return iterate(xp, one_step, max_iter, tol).iterates
 
 
 def table_literal_iterates(
-    model, x_pred: Any, P_pred: Any, y: Any, max_iter: int = 50, tol: float = 1e-10
+    model, x_pred: Any, P_pred: Any, y: Any, max_iter: int = DEFAULT_MAX_ITER, tol: float = DEFAULT_TOL
 ) -> np.ndarray:
     r"""Tableau des notes (000), :math:`f\to g` corrigé : :math:`x^{(i+1)} = \hat x^- + K_i[y - g(\hat x^-)]`."""
     return _iterate(
@@ -58,7 +54,7 @@ def table_literal_iterates(
 
 
 def no_correction_iterates(
-    model, x_pred: Any, P_pred: Any, y: Any, max_iter: int = 50, tol: float = 1e-10
+    model, x_pred: Any, P_pred: Any, y: Any, max_iter: int = DEFAULT_MAX_ITER, tol: float = DEFAULT_TOL
 ) -> np.ndarray:
     r"""Innovation à l'itéré sans terme de linéarisation : :math:`x^{(i+1)} = \hat x^- + K_i[y - g(x^{(i)})]`."""
     return _iterate(
@@ -68,7 +64,7 @@ def no_correction_iterates(
 
 
 def measurement_only_iterates(
-    model, x_pred: Any, P_pred: Any, y: Any, max_iter: int = 50, tol: float = 1e-10
+    model, x_pred: Any, P_pred: Any, y: Any, max_iter: int = DEFAULT_MAX_ITER, tol: float = DEFAULT_TOL
 ) -> np.ndarray:
     r"""Boucle des notes SE(3) (004) : :math:`x^{(i+1)} = x^{(i)} + K_i[y - g(x^{(i)})]` (a priori oublié)."""
     return _iterate(

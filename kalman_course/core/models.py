@@ -286,12 +286,19 @@ class NonlinearModel:
         V = _checked_matrix("h_noise_jacobian", self.h_noise_jacobian, x, (), (self.n_obs, self.R.shape[0]))
         return V.dot(self.R).dot(V.T)
 
-    def residual(self, y: np.ndarray, y_hat: np.ndarray) -> np.ndarray:
-        r"""Résidu :math:`y - \hat y`, les composantes angulaires ramenées dans :math:`(-\pi, \pi]`."""
-        d = y - y_hat
+    def residual(self, y: np.ndarray, y_hat: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:
+        r"""Résidu :math:`y - \hat y`, les composantes angulaires ramenées dans :math:`(-\pi, \pi]`.
+
+        ``idx`` : indices (dans la mesure complète) des composantes que contiennent ``y`` et ``y_hat``
+        quand la mesure est partielle (``None`` : toutes)."""
+        d = np.asarray(y - y_hat, dtype=float)
         if self.angle_indices:
-            idx = list(self.angle_indices)
-            d[idx] = wrap_angle(d[idx])
+            if idx is None:
+                angles = list(self.angle_indices)
+            else:
+                angles = [j for j, i in enumerate(idx) if int(i) in self.angle_indices]
+            if angles:
+                d[angles] = wrap_angle(d[angles])
         return d
 
     @classmethod

@@ -1,0 +1,82 @@
+r"""Algèbre linéaire commune à tous les filtres : symétrisation, gain par Cholesky, facteurs nommés.
+
+:math:`S` n'est jamais inversée : le gain :math:`K = P^-H^TS^{-1}` vient de la résolution de
+:math:`S K^T = H P^-` par Cholesky (LAPACK ``?posv`` via ``scipy.linalg``). Une factorisation qui échoue
+devient une :class:`~kalman_course.core.validation.KalmanInputError` qui dit quelle matrice et quoi
+vérifier, jamais une ``LinAlgError`` nue.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+from .validation import KalmanInputError
+
+__all__ = ["symmetrize", "kalman_gain", "correct", "cholesky_factor", "covariance_factor"]
+
+_posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
+
+#: Message par défaut quand :math:`S` n'est pas définie positive.
+S_NOT_PD = (
+    "La covariance d'innovation « S = C P⁻ Cᵀ + R » n'est pas définie positive (singulière "
+    "numériquement) : vérifiez les ordres de grandeur de P0, Q et R."
+)
+
+
+def symmetrize(P: np.ndarray) -> np.ndarray:
+    """Partie symétrique :math:`(P + P^T)/2` (efface l'asymétrie due aux arrondis) ; ``P`` (…, n, n)."""
+    P = P + np.swapaxes(P, -1, -2).copy()
+    P *= 0.5
+    return P
+
+
+def kalman_gain(P_pred: np.ndarray, H: np.ndarray, R: np.ndarray, where: str = ""):
+    r"""Gain :math:`K = P^-H^TS^{-1}` avec :math:`S = HP^-H^T + R`, par résolution de Cholesky.
+
+    ``P_pred`` (n, n), ``H`` (m, n), ``R`` (m, m). Renvoie ``(K (n, m), S (m, m), P^-H^T (n, m))``.
+    ``where`` précise le pas dans le message d'erreur (« au pas 12 »…).
+    """
+    PHt = P_pred.dot(H.T)
+    S = H.dot(PHt) + R
+    _, Kt, info = _posv(S, PHt.T)
+    if info != 0:
+        raise KalmanInputError(S_NOT_PD if not where else f"{S_NOT_PD[:-1]} ({where}).")
+    return Kt.T, S, PHt
+
+
+def correct(x_pred: np.ndarray, P_pred: np.ndarray, nu: np.ndarray, H: np.ndarray, R: np.ndarray,
+            joseph: bool = False):
+    r"""Correction linéaire commune à tous les filtres gaussiens (KF, EKF, EKF itéré, SE(3)).
+
+    .. math::
+
+        K = P^-H^T(HP^-H^T + R)^{-1},\qquad x = x^- + K\nu,\qquad
+        P = (I - KH)P^-\ \ \text{ou (Joseph)}\ \ (I-KH)P^-(I-KH)^T + KRK^T.
+
+    ``x_pred`` (n,), ``P_pred`` (n, n), ``nu`` (m,), ``H`` (m, n), ``R`` (m, m).
+    Renvoie ``(x (n,), P (n, n), K (n, m), S (m, m))``.
+    """
+    K, S, PHt = kalman_gain(P_pred, H, R)
+    x = x_pred + K.dot(nu)
+    if joseph:
+        IKH = np.eye(P_pred.shape[0]) - K.dot(H)
+        P = IKH.dot(P_pred).dot(IKH.T) + K.dot(R).dot(K.T)
+    else:
+        P = P_pred - K.dot(PHt.T)
+    return x, symmetrize(P), K, S
+
+
+def cholesky_factor(M: np.ndarray, name: str, what: str = "définie positive", lower: bool = True) -> np.ndarray:
+    """Facteur de Cholesky de ``M`` ; en cas d'échec, une :class:`KalmanInputError` qui nomme ``name``."""
+    try:
+        return scipy.linalg.cholesky(M, lower=lower, check_finite=False)
+    except np.linalg.LinAlgError:
+        raise KalmanInputError(f"« {name} » doit être {what}.") from None
+
+
+def covariance_factor(M: np.ndarray) -> np.ndarray:
+    r"""Facteur :math:`L` tel que :math:`LL^T = M` pour une covariance semi-définie positive (par ``eigh``,
+    donc valable aussi pour une covariance singulière, par exemple :math:`Q = 0`)."""
+    lam, V = scipy.linalg.eigh(M)
+    return V * np.sqrt(np.clip(lam, 0.0, None))
