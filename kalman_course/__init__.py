@@ -12,14 +12,12 @@ from . import figures, scenarios
 from .diagnostics.consistency import (
     CentringTest,
     ChiSquareTest,
-    ConsistencyRuns,
     WhitenessTest,
     autocorrelation,
     centring_test,
     chi2_band,
     chi2_mean_test,
     consistency_table,
-    monte_carlo_consistency,
     nees,
     nis,
     nis_test,
@@ -39,10 +37,11 @@ from .lecture.estimator import (
     spectral_radius,
 )
 from .core.jacobians import JacobianCheck, check_jacobian, numerical_jacobian, wrap_angle
-from .filters.kalman import Prediction, Update, kalman_filter, predict, recipe_step, update
+from .filters.kalman import Prediction, Update, kalman_filter, kalman_filter_runs, predict, recipe_step, update
 from .core.models import LinearGaussianModel, NonlinearModel
-from .core.results import FilterResult
-from .core.simulation import MonteCarlo, Simulation, monte_carlo, simulate
+from .core.results import FilterResult, FilterRuns
+from .core.simulation import Simulation, simulate
+from .diagnostics.monte_carlo import ConsistencyRuns, MonteCarlo, monte_carlo, monte_carlo_consistency
 from .tables import Table
 from .filters.filterpy_unscented import filterpy_unscented_filter
 from .core.validation import KalmanInputError
@@ -84,6 +83,7 @@ __all__ = [
     "LinearGaussianModel",
     "NonlinearModel",
     "FilterResult",
+    "FilterRuns",
     "KalmanInputError",
     # filtre linéaire
     "Prediction",
@@ -91,6 +91,7 @@ __all__ = [
     "predict",
     "update",
     "kalman_filter",
+    "kalman_filter_runs",
     "recipe_step",
     # construction de l'estimateur (chapitres 2 à 4)
     "MeanError",

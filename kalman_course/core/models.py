@@ -270,20 +270,30 @@ class NonlinearModel:
             return numerical_jacobian(self.observe, x, angle_indices=self.angle_indices, name="h")
         return _checked_matrix("h_jacobian", self.h_jacobian, x, (), (self.n_obs, self.n_state))
 
+    def process_noise_gain(self, x: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
+        r""":math:`W = \partial f/\partial\phi` en :math:`(x, u)`, forme (n, q) (identité si le bruit est additif)."""
+        if self.f_noise_jacobian is None:
+            return np.eye(self.n_state)
+        return _checked_matrix("f_noise_jacobian", self.f_noise_jacobian, x, (u,), (self.n_state, self.Q.shape[0]))
+
+    def measurement_noise_gain(self, x: np.ndarray) -> np.ndarray:
+        r""":math:`V = \partial h/\partial\psi` en :math:`x`, forme (m, r) (identité si le bruit est additif)."""
+        if self.h_noise_jacobian is None:
+            return np.eye(self.n_obs)
+        return _checked_matrix("h_noise_jacobian", self.h_noise_jacobian, x, (), (self.n_obs, self.R.shape[0]))
+
     def process_noise(self, x: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
         r"""Covariance du bruit d'état ramenée à l'état, :math:`W Q W^T` (n, n) (:math:`Q` si bruit additif)."""
         if self.f_noise_jacobian is None:
             return self.Q
-        W = _checked_matrix(
-            "f_noise_jacobian", self.f_noise_jacobian, x, (u,), (self.n_state, self.Q.shape[0])
-        )
+        W = self.process_noise_gain(x, u)
         return W.dot(self.Q).dot(W.T)
 
     def measurement_noise(self, x: np.ndarray) -> np.ndarray:
         r"""Covariance du bruit de mesure ramenée à la mesure, :math:`V R V^T` (m, m) (:math:`R` si additif)."""
         if self.h_noise_jacobian is None:
             return self.R
-        V = _checked_matrix("h_noise_jacobian", self.h_noise_jacobian, x, (), (self.n_obs, self.R.shape[0]))
+        V = self.measurement_noise_gain(x)
         return V.dot(self.R).dot(V.T)
 
     def residual(self, y: np.ndarray, y_hat: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:

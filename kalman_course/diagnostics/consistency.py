@@ -27,24 +27,21 @@ import numpy as np
 import scipy.linalg
 import scipy.stats
 
-from ..filters.kalman import kalman_filter
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult, freeze, freeze_fields
-from ..core.simulation import as_generator, simulate
+from ..core.simulation import check_positive_int
 from ..tables import Table
 from ..core.validation import KalmanInputError, as_controls, as_float_array, as_square_matrix, as_vector, check_pd, shape_text
 
 __all__ = [
     "ChiSquareTest",
     "CentringTest",
-    "ConsistencyRuns",
     "WhitenessTest",
     "autocorrelation",
     "centring_test",
     "chi2_band",
     "chi2_mean_test",
     "consistency_table",
-    "monte_carlo_consistency",
     "nees",
     "nis",
     "nis_test",
@@ -80,12 +77,6 @@ def _check_level(level: Any) -> float:
             f"« level » doit être strictement entre 0 et 1 (par exemple 0.95 pour 95 %) ; reçu {value!r}."
         )
     return value
-
-
-def _check_positive_int(name: str, value: Any, minimum: int = 1) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise KalmanInputError(f"« {name} » doit être un entier ≥ {minimum} ; reçu {value!r}.")
-    return int(value)
 
 
 def _cholesky_or_error(M: np.ndarray, name: str, k: int) -> np.ndarray:
@@ -217,8 +208,8 @@ def chi2_band(dof: int, n_values: int = 1, level: float = 0.95) -> tuple[float, 
     (la somme de :math:`N` lois :math:`\chi^2_d` indépendantes) et :math:`\beta` = ``level``.
     Renvoie ``(borne basse, borne haute)``.
     """
-    d = _check_positive_int("dof", dof)
-    N = _check_positive_int("n_values", n_values)
+    d = check_positive_int("dof", dof)
+    N = check_positive_int("n_values", n_values)
     beta = _check_level(level)
     lo, hi = scipy.stats.chi2.ppf([(1 - beta) / 2, (1 + beta) / 2], N * d) / N
     return float(lo), float(hi)
@@ -280,7 +271,7 @@ def chi2_mean_test(values: Any, dof: Any, *, level: float = 0.95, quantity: str 
     beta = _check_level(level)
     v = as_float_array("values", values, allow_nan=True)
     if isinstance(dof, (int, np.integer)) and not isinstance(dof, (bool, np.bool_)):
-        d = np.full(v.shape, _check_positive_int("dof", dof), dtype=float)
+        d = np.full(v.shape, check_positive_int("dof", dof), dtype=float)
     else:
         d = as_float_array("dof", dof)
         if d.shape != v.shape:
@@ -352,7 +343,7 @@ def _as_series(name: str, value: Any) -> np.ndarray:
 def _check_max_lag(max_lag: Any, T: int) -> int:
     if max_lag is None:
         max_lag = max(1, min(DEFAULT_MAX_LAG, T // 5))
-    L = _check_positive_int("max_lag", max_lag)
+    L = check_positive_int("max_lag", max_lag)
     if L > T // 2:
         raise KalmanInputError(
             f"« max_lag » = {L} est trop grand pour une série de T = {T} valeurs : au plus T/2 = {T // 2} "
@@ -561,86 +552,6 @@ def centring_test(innovations: Any, *, level: float = 0.95) -> CentringTest:
         level=beta,
         centred=bool(p >= 1 - beta),
     )
-
-
-# --------------------------------------------------------------------------- Monte-Carlo
-
-
-@dataclass(frozen=True, eq=False)
-class ConsistencyRuns:
-    r"""Résultat de :func:`monte_carlo_consistency` : ``nees`` (R, T) et ``nis`` (R, T) de ``R``
-    tirages indépendants ; ``n_state`` = :math:`n`, ``n_obs`` = :math:`m` (degrés de liberté)."""
-
-    nees: np.ndarray
-    nis: np.ndarray
-    n_state: int
-    n_obs: int
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "nees", freeze(self.nees))
-        object.__setattr__(self, "nis", freeze(self.nis))
-
-    @property
-    def n_runs(self) -> int:
-        """Nombre de tirages ``R``."""
-        return self.nees.shape[0]
-
-    def nees_test(self, step: int = -1, *, level: float = 0.95) -> ChiSquareTest:
-        r"""Test du :math:`\chi^2` sur la NEES moyenne des ``R`` tirages au pas ``step``
-        (:math:`\sum_r \epsilon_k^{(r)} \sim \chi^2_{Rn}`)."""
-        T = self.nees.shape[1]
-        if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) or not -T <= step < T:
-            raise KalmanInputError(f"« step » doit être un indice de pas entier entre {-T} et {T - 1} ; reçu {step!r}.")
-        return chi2_mean_test(self.nees[:, step], self.n_state, level=level, quantity="NEES")
-
-
-def monte_carlo_consistency(
-    true_model: LinearGaussianModel,
-    n_steps: int,
-    n_runs: int,
-    *,
-    x0_hat: Any,
-    P0: Any,
-    rng: Any,
-    filter_model: LinearGaussianModel | None = None,
-    u: Any = None,
-) -> ConsistencyRuns:
-    r"""NEES et NIS de ``n_runs`` tirages indépendants : pour chaque tirage,
-    :math:`x_0 \sim \mathcal N(\hat x_0, P_0)` (l'hypothèse d'initialisation du filtre), simulation de
-    ``true_model`` sur ``n_steps`` pas (:func:`simulate`), filtre de Kalman avec ``filter_model``
-    (``true_model`` par défaut, c'est-à-dire un filtre bien réglé) depuis :math:`(\hat x_0, P_0)`.
-
-    Paramètres : ``x0_hat`` (n,), ``P0`` (n, n) définie positive, ``u`` (T, p) ou ``None``,
-    ``rng`` graine entière ou ``numpy.random.Generator`` (obligatoire).
-    Renvoie :class:`ConsistencyRuns` (``nees`` et ``nis`` de forme (R, T)).
-    """
-    for name, model in (("true_model", true_model), ("filter_model", filter_model)):
-        if model is not None and not isinstance(model, LinearGaussianModel):
-            raise KalmanInputError(f"« {name} » doit être un LinearGaussianModel ; reçu {type(model).__name__}.")
-    fmodel = true_model if filter_model is None else filter_model
-    dims = ("n_state", "n_obs", "n_control")
-    if any(getattr(fmodel, d) != getattr(true_model, d) for d in dims):
-        raise KalmanInputError(
-            "« filter_model » doit avoir les dimensions de « true_model » (états, mesures, commandes) ; "
-            f"reçu {tuple(getattr(fmodel, d) for d in dims)} au lieu de {tuple(getattr(true_model, d) for d in dims)}."
-        )
-    T = _check_positive_int("n_steps", n_steps)
-    R = _check_positive_int("n_runs", n_runs, minimum=2)
-    gen = as_generator(rng)
-    n = true_model.n_state
-    x0h = as_vector("x0_hat", x0_hat, n)
-    P0_arr = check_pd("P0", as_square_matrix("P0", P0, n))
-    U = as_controls("u", u, T, true_model.n_control)
-    L0 = scipy.linalg.cholesky(P0_arr, lower=True)  # x0 = x̂0 + L0 ξ, ξ ~ N(0, I)
-    nees_runs = np.empty((R, T))
-    nis_runs = np.empty((R, T))
-    for r in range(R):
-        x0 = x0h + L0 @ gen.standard_normal(n)
-        sim = simulate(true_model, x0, T, U, rng=gen)
-        res = kalman_filter(fmodel, sim.y, x0h, P0_arr, U)
-        nees_runs[r] = nees(sim.x, res)
-        nis_runs[r] = nis(res)
-    return ConsistencyRuns(nees=nees_runs, nis=nis_runs, n_state=n, n_obs=true_model.n_obs)
 
 
 # --------------------------------------------------------------------------- synthèse

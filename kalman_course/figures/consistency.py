@@ -12,7 +12,6 @@ import scipy.stats
 
 from ..diagnostics.consistency import (
     chi2_band,
-    monte_carlo_consistency,
     nis,
     whitened_innovations,
     whiteness_test,
@@ -32,6 +31,7 @@ from ..scenarios.engine import (
     engine_model,
 )
 from ..core.simulation import simulate
+from ..diagnostics.monte_carlo import monte_carlo_consistency
 from ._registry import new_figure, register
 
 CHAPTER = "tests-statistiques"

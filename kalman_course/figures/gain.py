@@ -20,7 +20,8 @@ from ..scenarios.engine import (
     engine_commands,
     engine_model,
 )
-from ..core.simulation import monte_carlo, simulate
+from ..core.simulation import simulate
+from ..diagnostics.monte_carlo import monte_carlo
 from ._registry import new_figure, register
 
 CHAPTER_LOOP = "predicteur-correcteur"

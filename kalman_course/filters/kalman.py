@@ -14,10 +14,20 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from ..core.linalg import correct, symmetrize
+from ..core.linalg import S_NOT_PD, correct, kalman_gain, symmetrize
 from ..core.models import LinearGaussianModel
-from ..core.results import FilterResult
-from ..core.validation import as_gaussian, as_vector, check_control_allowed
+from ..core.results import FilterResult, FilterRuns
+from ..core.validation import (
+    KalmanInputError,
+    as_float_array,
+    as_gaussian,
+    as_square_matrix,
+    as_vector,
+    check_control_allowed,
+    check_instance,
+    check_psd,
+    shape_text,
+)
 from .engine import Correction, FilterFamily, gaussian_moments, gaussian_prior, run_filter
 
 __all__ = [
@@ -209,4 +219,148 @@ def kalman_family(joseph: bool = False) -> FilterFamily:
         predict=predict_step,
         update=update_step,
         moments=gaussian_moments,
+    )
+
+
+# --------------------------------------------------------------------------- tirages en lot
+
+
+def kalman_filter_runs(
+    model: LinearGaussianModel,
+    Y: Any,
+    x0: Any,
+    P0: Any,
+    u: Any = None,
+    joseph: bool = False,
+) -> FilterRuns:
+    r"""Filtre de Kalman sur ``N`` tirages à la fois (mêmes équations que :func:`kalman_filter`).
+
+    Sans mesure manquante, la récurrence des covariances :math:`P_{k\mid k-1}, S_k, K_k, P_{k\mid k}` ne
+    dépend pas des mesures : elle est calculée **une fois** pour tous les tirages, et seule la moyenne est
+    propagée en lot, :math:`\hat X_{k\mid k-1} = \hat X_{k-1\mid k-1}A^T + (Bu_k)^T`,
+    :math:`\hat X_{k\mid k} = \hat X_{k\mid k-1} + (Y_k - \hat X_{k\mid k-1}C^T)K_k^T` (une ligne par
+    tirage). Avec des mesures manquantes (``NaN``, tirage par tirage), chaque tirage garde sa covariance ;
+    à chaque pas, les tirages qui ont le même motif de composantes observées sont corrigés ensemble.
+
+    Paramètres
+    ----------
+    model : LinearGaussianModel
+    Y : (N, T, m), ou (N, T) si m = 1 — mesures des ``N`` tirages ; ``NaN`` : composante manquante.
+    x0 : (n,) commun, ou (N, n) un par tirage. P0 : (n, n) commun.
+    u : (T, p) commun, ou (N, T, p), optionnel.
+    joseph : forme de Joseph pour la covariance a posteriori.
+
+    Renvoie un :class:`~kalman_course.core.results.FilterRuns` : ``x`` (N, T, n), ``innovation``
+    (N, T, m)… et ``P``, ``P_pred``, ``K``, ``S`` de forme (T, …) s'ils sont communs (aucune mesure
+    manquante), (N, T, …) sinon. Chaque tirage est égal à :func:`kalman_filter` sur ses mesures.
+    """
+    model = check_instance("model", model, LinearGaussianModel, "pour un modèle non linéaire, bouclez sur extended_kalman_filter")
+    n, m, p = model.n_state, model.n_obs, model.n_control
+    Yarr = as_float_array("Y", Y, allow_nan=True)
+    if Yarr.ndim == 2 and m == 1:
+        Yarr = Yarr[:, :, None]
+    if Yarr.ndim != 3 or Yarr.shape[2] != m or Yarr.shape[0] == 0 or Yarr.shape[1] == 0:
+        extra = " ou (N, T)" if m == 1 else ""
+        raise KalmanInputError(
+            f"« Y » doit être de forme (N, T, {m}){extra} : N tirages de T mesures ; reçu {shape_text(Yarr.shape)}."
+        )
+    N, T, _ = Yarr.shape
+    X0 = as_float_array("x0", x0)
+    if X0.shape == (n,):
+        X0 = np.broadcast_to(X0, (N, n)).copy()
+    elif X0.shape != (N, n):
+        raise KalmanInputError(
+            f"« x0 » doit être de forme ({n},) (commun) ou ({N}, {n}) (un par tirage) ; reçu {shape_text(X0.shape)}."
+        )
+    P = check_psd("P0", as_square_matrix("P0", P0, n))
+    BU = _batch_controls(model, u, N, T)  # None, (T, n) ou (N, T, n)
+    observed = ~np.isnan(Yarr)
+    A, C, Q, R = model.A, model.C, model.Q, model.R
+
+    X = X0
+    xs, xps = np.empty((N, T, n)), np.empty((N, T, n))
+    nus = np.full((N, T, m), np.nan)
+    if observed.all():
+        Ps, Pps, Ks, Ss = np.empty((T, n, n)), np.empty((T, n, n)), np.empty((T, n, m)), np.empty((T, m, m))
+        for k in range(T):
+            Xp = X.dot(A.T)
+            if BU is not None:
+                Xp += BU[..., k, :]
+            P_pred = symmetrize(A.dot(P).dot(A.T) + Q)
+            K, S, PCt = kalman_gain(P_pred, C, R, f"au pas {k}")
+            nu = Yarr[:, k] - Xp.dot(C.T)
+            X = Xp + nu.dot(K.T)
+            if joseph:
+                IKC = np.eye(n) - K.dot(C)
+                P = symmetrize(IKC.dot(P_pred).dot(IKC.T) + K.dot(R).dot(K.T))
+            else:
+                P = symmetrize(P_pred - K.dot(PCt.T))
+            xps[:, k], xs[:, k], nus[:, k] = Xp, X, nu
+            Pps[k], Ps[k], Ks[k], Ss[k] = P_pred, P, K, S
+        n_iter = np.ones((N, T), dtype=int)
+        return FilterRuns(x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss,
+                          observed=observed, n_iter=n_iter)
+
+    Ps, Pps = np.empty((N, T, n, n)), np.empty((N, T, n, n))
+    Ks, Ss = np.zeros((N, T, n, m)), np.full((N, T, m, m), np.nan)
+    n_iter = np.zeros((N, T), dtype=int)
+    Pr = np.broadcast_to(P, (N, n, n)).copy()
+    for k in range(T):
+        Xp = X.dot(A.T)
+        if BU is not None:
+            Xp += BU[..., k, :]
+        Pp = symmetrize(A @ Pr @ A.T + Q)
+        X, Pr = Xp.copy(), Pp.copy()
+        patterns, group = np.unique(observed[:, k], axis=0, return_inverse=True)
+        for g, pattern in enumerate(patterns):
+            if not pattern.any():
+                continue
+            runs = np.flatnonzero(group.ravel() == g)
+            idx = np.flatnonzero(pattern)
+            Ck, Rk = C[idx], R[np.ix_(idx, idx)]
+            PCt = Pp[runs] @ Ck.T                                  # (g, n, q)
+            S = Ck @ PCt + Rk                                      # (g, q, q)
+            K = np.swapaxes(_batched_solve_pd(S, np.swapaxes(PCt, 1, 2), k), 1, 2)  # (g, n, q)
+            nu = Yarr[runs, k][:, idx] - Xp[runs] @ Ck.T           # (g, q)
+            X[runs] = Xp[runs] + np.einsum("gij,gj->gi", K, nu)
+            if joseph:
+                IKC = np.eye(n) - K @ Ck
+                Pr[runs] = symmetrize(IKC @ Pp[runs] @ np.swapaxes(IKC, 1, 2) + K @ Rk @ np.swapaxes(K, 1, 2))
+            else:
+                Pr[runs] = symmetrize(Pp[runs] - K @ np.swapaxes(PCt, 1, 2))
+            for j, r in enumerate(runs):
+                Ks[r, k][:, idx] = K[j]
+                Ss[r, k][np.ix_(idx, idx)] = S[j]
+                nus[r, k, idx] = nu[j]
+            n_iter[runs, k] = 1
+        xps[:, k], xs[:, k], Pps[:, k], Ps[:, k] = Xp, X, Pp, Pr
+    return FilterRuns(x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss,
+                      observed=observed, n_iter=n_iter)
+
+
+def _batched_solve_pd(S: np.ndarray, B: np.ndarray, k: int) -> np.ndarray:
+    """Résout :math:`S_j X_j = B_j` pour une pile de matrices définies positives (Cholesky)."""
+    try:
+        L = np.linalg.cholesky(S)
+    except np.linalg.LinAlgError:
+        raise KalmanInputError(f"{S_NOT_PD[:-1]} (au pas {k}).") from None
+    Z = np.linalg.solve(L, B)
+    return np.linalg.solve(np.swapaxes(L, 1, 2), Z)
+
+
+def _batch_controls(model: LinearGaussianModel, u: Any, N: int, T: int) -> np.ndarray | None:
+    """Termes :math:`Bu` : ``None``, (T, n) communs ou (N, T, n)."""
+    if u is None:
+        return None
+    check_control_allowed("u", model.n_control)
+    p = model.n_control
+    U = as_float_array("u", u)
+    if U.ndim == 1 and p == 1:
+        U = U[:, None]
+    if U.ndim == 2 and U.shape == (T, p):
+        return U @ model.B.T
+    if U.ndim == 3 and U.shape == (N, T, p):
+        return U @ model.B.T
+    raise KalmanInputError(
+        f"« u » doit être de forme ({T}, {p}) (commune) ou ({N}, {T}, {p}) (une par tirage) ; reçu {shape_text(U.shape)}."
     )
