@@ -2,12 +2,15 @@
 
 Les chapitres du livre n'appellent que les noms exportés ici et les sous-modules ``scenarios``
 (exemples du cours), ``figures`` (registre des figures), ``errata`` (formules imprimées fausses, pour
-les démontrer) et ``interactive`` (curseurs ; importé à la demande, seul à dépendre de bokeh et
-d'ipywidgets).
+les démontrer), ``numbers`` (les nombres en français) et ``interactive`` (curseurs).
+
+Importer le paquet ne charge que les filtres (numpy et scipy) : ``figures`` (matplotlib),
+``scenarios``, ``interactive`` (bokeh, ipywidgets), ``numbers`` (Babel) et ``datasets`` se chargent à
+leur première utilisation (``kc.figures.draw(...)`` suffit). filterpy n'est jamais importé par le paquet
+hors de l'adaptateur de l'UKF de référence.
 """
 
 from .lecture import errata
-from . import figures, scenarios
 # cohérence
 from .diagnostics.consistency import (
     CentringTest,
@@ -36,7 +39,8 @@ from .lecture.estimator import (
     measurement_initialisation,
     spectral_radius,
 )
-from .core.jacobians import JacobianCheck, check_jacobian, numerical_jacobian, wrap_angle
+from .core.angles import wrap_angle
+from .core.jacobians import JacobianCheck, check_jacobian, numerical_jacobian
 from .filters.kalman import Prediction, Update, kalman_filter, kalman_filter_runs, predict, recipe_step, update
 from .core.models import LinearGaussianModel, NonlinearModel
 from .core.results import FilterResult, FilterRuns
@@ -177,15 +181,25 @@ __all__ = [
     "figures",
     "scenarios",
     "interactive",
+    "numbers",
 ]
 
 __version__ = "0.1.0"
 
 
+#: Sous-modules chargés à la première utilisation (voir l'en-tête).
+_LAZY_SUBMODULES = ("figures", "scenarios", "interactive", "numbers", "datasets")
+
+
 def __getattr__(name: str):
-    # ``kc.interactive`` à la demande : bokeh et ipywidgets ne sont importés que si l'on s'en sert.
-    if name == "interactive":
+    if name in _LAZY_SUBMODULES:
         import importlib
 
-        return importlib.import_module(".interactive", __name__)
-    raise AttributeError(f"module 'kalman_course' has no attribute {name!r}")
+        module = importlib.import_module(f".{name}", __name__)
+        globals()[name] = module
+        return module
+    raise AttributeError(f"le module « kalman_course » n'a pas d'attribut {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY_SUBMODULES))

@@ -62,17 +62,19 @@ def test_voltage_axes_are_log_spaced_and_centred_on_the_chapter():
     assert q.default_value == Q and r.default_value == R  # égalité exacte : même figure
 
 
-def test_voltage_grid_equals_kalman_filter_at_every_point(vgrid):
+def test_voltage_grid_equals_filterpy_at_every_point(vgrid):
+    """Chaque point de la grille précalculée contre la référence indépendante (boucle de filterpy) ; le gain
+    contre sa forme a posteriori K = P Cᵀ R⁻¹ (ici P/R)."""
     q, r = vgrid.axes
     z = kc.scenarios.constant_voltage_measurements(50)
     assert vgrid.shape == (15, 15) and all(v.shape == (15, 15, 50) for v in vgrid.series.values())
     for i, Q in enumerate(q.values):
         for j, R in enumerate(r.values):
-            res = kc.kalman_filter(kc.scenarios.constant_voltage_model(Q=Q, R=R), z, x0=0.0, P0=1.0)
+            x, P, _, _ = filterpy_kf(kc.scenarios.constant_voltage_model(Q=Q, R=R), z, [0.0], [[1.0]])
             run = vgrid.run(i, j)
-            np.testing.assert_array_equal(run["x"], res.x[:, 0])
-            np.testing.assert_array_equal(run["P"], res.P[:, 0, 0])
-            np.testing.assert_array_equal(run["K"], res.K[:, 0, 0])
+            np.testing.assert_allclose(run["x"], x[:, 0], rtol=1e-9, atol=1e-12)
+            np.testing.assert_allclose(run["P"], P[:, 0, 0], rtol=1e-9, atol=1e-15)
+            np.testing.assert_allclose(run["K"], P[:, 0, 0] / R, rtol=1e-9, atol=1e-15)
     # l'ordre aplati envoyé au navigateur : l'exécution (i, j) commence à (i·N1 + j)·T
     i, j = 3, 11
     start = (i * 15 + j) * 50

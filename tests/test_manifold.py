@@ -26,7 +26,6 @@ from kalman_course.geometry.camera import (
     project,
     transform_points,
 )
-from kalman_course.core.jacobians import numerical_jacobian
 from kalman_course.scenarios import camera_target as ct
 
 CAM = PinholeCamera(fx=520.0, fy=500.0, cx=320.0, cy=240.0)
@@ -92,23 +91,6 @@ def test_projection_and_intrinsics():
     assert np.array_equal(CAM.intrinsics, CAM.K_cam)
 
 
-@pytest.mark.parametrize("perturbation", ["right", "left"])
-def test_pixel_jacobian_matches_central_differences_on_the_retraction(perturbation):
-    gen = np.random.default_rng(7)
-    worst = 0.0
-    for _ in range(100):
-        T, points = _random_pose_and_points(gen)
-        check = check_camera_jacobian(T, points, CAM, perturbation)  # h = 1e-6, relatif 1e-6
-        assert check.ok, repr(check)
-        worst = max(worst, check.max_rel_error)
-    assert worst < 1e-8  # mesuré ~2e-10
-
-
-def test_jacobian_check_uses_step_1e6_and_the_shared_helper():
-    T, points = _random_pose_and_points(np.random.default_rng(1))
-    check = check_camera_jacobian(T, points, CAM)
-    Jn = numerical_jacobian(lambda d: camera_measurement(T @ lie.se3_exp(d), points, CAM), np.zeros(6), step=1e-6)
-    assert np.array_equal(check.numerical, Jn)
 
 
 def test_wrong_jacobians_fail_the_check():
@@ -239,21 +221,6 @@ def test_monte_carlo_nees_iekf_consistent_ekf_not():
 
 # --------------------------------------------------------------------------- prédiction et suivi
 
-
-def test_prediction_jacobians_match_central_differences():
-    gen = np.random.default_rng(2)
-    u = gen.normal(size=6) * 0.5
-    Eu = lie.se3_exp(u)
-    Eu_inv = np.linalg.inv(Eu)
-    # erreur après un pas : e' = Log(Exp(u)⁻¹ Exp(e) Exp(u + w))
-    Fn = numerical_jacobian(lambda e: lie.se3_log(Eu_inv @ lie.se3_exp(e) @ Eu), np.zeros(6))
-    Gn = numerical_jacobian(lambda w: lie.se3_log(Eu_inv @ lie.se3_exp(u + w)), np.zeros(6))
-    P = np.diag(gen.uniform(0.01, 0.1, 6))
-    Q = np.diag(gen.uniform(0.001, 0.01, 6))
-    T = lie.se3_exp(gen.normal(size=6))
-    pred = kc.se3_predict(T, P, u, Q)
-    assert np.max(np.abs(pred.T - T @ scipy.linalg.expm(_hat(u)))) <= 1e-12
-    assert np.max(np.abs(pred.P - (Fn @ P @ Fn.T + Gn @ Q @ Gn.T))) <= 1e-9
 
 
 def test_tracking_run_converges_and_ekf_is_one_iteration():

@@ -159,5 +159,85 @@ def test_simulate_rejects_bad_input(kwargs, pattern):
         kc.simulate(model2(), **args)
 
 
-def test_errors_are_value_errors_for_generic_handlers():
-    assert issubclass(KalmanInputError, ValueError)
+def test_errors_are_caught_by_generic_value_error_handlers():
+    """Un code qui attrape ``ValueError`` (l'erreur d'argument de Python) attrape aussi les erreurs du paquet,
+    avec leur message français."""
+    try:
+        kc.kalman_filter(model2(), np.zeros((3, 5)), np.zeros(2), np.eye(2))
+    except ValueError as exc:
+        assert "« y » doit être de forme (T, 1)" in str(exc)
+    else:  # pragma: no cover
+        pytest.fail("une mesure de mauvaise forme doit lever une erreur")
+
+
+# --------------------------------------------------------------------------- erreurs qui s'échappaient
+
+
+def test_simulate_accepts_a_nonlinear_model():
+    """Le modèle linéaire vu comme NonlinearModel donne la même trajectoire, avec la même graine."""
+    lin = model2(B=[[1.0], [0.5]])
+    u = np.linspace(0.0, 1.0, 20)
+    a = kc.simulate(lin, [1.0, -1.0], 20, u, rng=4)
+    b = kc.simulate(kc.NonlinearModel.from_linear(lin), [1.0, -1.0], 20, u, rng=4)
+    np.testing.assert_allclose(b.x, a.x, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(b.y, a.y, rtol=1e-12, atol=1e-12)
+
+
+def test_simulate_nonlinear_uses_the_noise_jacobians():
+    W = np.array([[1.0], [2.0]])
+    m = kc.NonlinearModel(lambda x, u: x, lambda x: x[:1], [[0.25]], [[1e-6]], f_noise_jacobian=W)
+    sim = kc.simulate(m, [0.0, 0.0], 200, rng=1)
+    steps = np.diff(np.vstack([[0.0, 0.0], sim.x]), axis=0)
+    np.testing.assert_allclose(steps[:, 1], 2.0 * steps[:, 0], rtol=1e-12)  # bruit le long de W
+    assert 0.4 < steps[:, 0].std() < 0.6  # écart-type 0,5
+
+
+def test_monte_carlo_refuses_a_nonlinear_model_in_french():
+    m = kc.NonlinearModel.from_linear(model2())
+    with pytest.raises(KalmanInputError, match="« model » doit être un LinearGaussianModel ; reçu NonlinearModel"):
+        kc.monte_carlo(m, None, 5, 5, x0_mean=np.zeros(2), x0_cov=np.eye(2), x0_hat=np.zeros(2), rng=0, P0=np.eye(2))
+
+
+def test_jacobian_tools_turn_user_errors_into_french_errors():
+    with pytest.raises(KalmanInputError, match=r"jacobienne « H » » a échoué.*ZeroDivisionError"):
+        kc.check_jacobian(np.sin, lambda x: 1 / 0, np.array([1.0]), name="H")
+    with pytest.raises(KalmanInputError, match="« x » doit être un tableau de nombres réels"):
+        kc.numerical_jacobian(np.sin, "abc")
+
+
+def test_position_rmse_wants_state_sequences():
+    from kalman_course.scenarios import tag
+
+    with pytest.raises(KalmanInputError, match=r"« x_est » doit être une suite d'états \(T, n\).*la forme \(5,\)"):
+        tag.position_rmse(np.zeros(5), np.zeros(5))
+    with pytest.raises(KalmanInputError, match="même forme"):
+        tag.position_rmse(np.zeros((5, 4)), np.zeros((6, 4)))
+
+
+def test_filterpy_ukf_with_singular_P0_is_a_french_error():
+    m = kc.NonlinearModel.from_linear(kc.LinearGaussianModel(np.eye(2), np.eye(2), np.eye(2), np.eye(2)))
+    with pytest.raises(KalmanInputError, match="« P0 » doit être définie positive"):
+        kc.filterpy_unscented_filter(m, np.zeros((3, 2)), np.zeros(2), np.zeros((2, 2)))
+
+
+def test_shapes_read_well_in_messages():
+    with pytest.raises(KalmanInputError, match=r"« x0 » doit être un vecteur de forme \(2,\) ; reçu un scalaire\."):
+        kc.kalman_filter(model2(), np.zeros(5), 1.0, np.eye(2))
+    with pytest.raises(KalmanInputError, match=r"reçu la forme \(3,\)\."):
+        kc.kalman_filter(model2(), np.zeros(5), np.zeros(3), np.eye(2))
+
+
+def test_extended_srif_with_singular_jacobian_does_not_advise_a_missing_method():
+    m = kc.NonlinearModel(lambda x, u: np.array([x[0], 0.0]), lambda x: x[:1], np.eye(2), [[1.0]])
+    with pytest.raises(KalmanInputError, match="jacobienne « F ».*singulière") as err:
+        kc.extended_square_root_information_filter(m, np.zeros(3), np.zeros(2), np.eye(2))
+    assert "joint" not in str(err.value)
+
+
+def test_se3_filter_with_zero_prior_and_noise_runs_instead_of_blaming_P_pred():
+    from kalman_course.scenarios import camera_target as ct
+
+    truth, y, U, T0, P0 = ct.camera_tracking_data(3)
+    res = kc.se3_iterated_filter(y, T0, np.zeros((6, 6)), ct.TARGET_POINTS, ct.CAMERA, 1.0, u=U)
+    np.testing.assert_allclose(res.P, 0.0, atol=1e-12)  # aucune incertitude : les mesures ne corrigent rien
+    np.testing.assert_allclose(res.T[-1], T0 @ kc.se3_exp(U[0]) @ kc.se3_exp(U[1]) @ kc.se3_exp(U[2]), atol=1e-12)

@@ -20,19 +20,13 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .validation import KalmanInputError, as_vector, call_user_function, check_finite_output, shape_text
+from .angles import wrap_angle
+from .validation import KalmanInputError, as_float_array, as_vector, call_user_function, check_finite_output, shape_text
 
-__all__ = ["JacobianCheck", "numerical_jacobian", "check_jacobian", "wrap_angle"]
+__all__ = ["JacobianCheck", "numerical_jacobian", "check_jacobian"]
 
 #: Pas relatif des différences centrées : :math:`\varepsilon^{1/3}` équilibre troncature et arrondi.
 CENTRAL_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
-
-
-def wrap_angle(a: Any) -> np.ndarray:
-    r"""Ramène des angles (rad) dans :math:`(-\pi, \pi]`."""
-    a = np.asarray(a, dtype=float)
-    # np.mod(·, 2π) est dans [0, 2π) : π − mod(π − a, 2π) est dans (−π, π]
-    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
 
 
 def _evaluate(func: Callable[..., Any], x: np.ndarray, args: tuple, name: str) -> np.ndarray:
@@ -70,7 +64,7 @@ def numerical_jacobian(
         :math:`(-\pi, \pi]` (sinon un angle qui franchit :math:`\pm\pi` donne une dérivée énorme).
     name : nom de la fonction dans les messages d'erreur.
     """
-    x = np.asarray(x, dtype=float)
+    x = as_float_array("x", x)
     if x.ndim != 1:
         raise KalmanInputError(f"« x » doit être un vecteur 1-D ; reçu {shape_text(x.shape)}.")
     rel = CENTRAL_STEP if step is None else float(step)
@@ -158,9 +152,10 @@ def check_jacobian(
     Renvoie un :class:`JacobianCheck` (vrai si la jacobienne est correcte). Une jacobienne de mauvaise
     forme lève une :class:`KalmanInputError`.
     """
-    x = as_vector("x", x, np.asarray(x).size)
+    x = as_float_array("x", x)
+    x = as_vector("x", x, x.size)
     Jn = numerical_jacobian(func, x, args, angle_indices=angle_indices, name=name)
-    Ja = np.asarray(jacobian(x, *args), dtype=float)
+    Ja = np.asarray(call_user_function(f"jacobienne « {name} »", jacobian, x, args), dtype=float)
     if Ja.ndim == 0 and Jn.shape == (1, 1):
         Ja = Ja.reshape(1, 1)
     if Ja.shape != Jn.shape:

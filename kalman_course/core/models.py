@@ -20,7 +20,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .jacobians import numerical_jacobian, wrap_angle
+from .angles import wrap_angle
+from .jacobians import numerical_jacobian
 from .validation import (
     KalmanInputError,
     as_float_array,

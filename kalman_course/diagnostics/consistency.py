@@ -27,11 +27,10 @@ import numpy as np
 import scipy.linalg
 import scipy.stats
 
-from ..core.models import LinearGaussianModel
-from ..core.results import FilterResult, freeze, freeze_fields
+from ..core.results import FilterResult, freeze_fields
 from ..core.simulation import check_positive_int
 from ..tables import Table
-from ..core.validation import KalmanInputError, as_controls, as_float_array, as_square_matrix, as_vector, check_pd, shape_text
+from ..core.validation import KalmanInputError, as_float_array, shape_text
 
 __all__ = [
     "ChiSquareTest",

@@ -255,7 +255,7 @@ def kalman_filter_runs(
     manquante), (N, T, …) sinon. Chaque tirage est égal à :func:`kalman_filter` sur ses mesures.
     """
     model = check_instance("model", model, LinearGaussianModel, "pour un modèle non linéaire, bouclez sur extended_kalman_filter")
-    n, m, p = model.n_state, model.n_obs, model.n_control
+    n, m = model.n_state, model.n_obs
     Yarr = as_float_array("Y", Y, allow_nan=True)
     if Yarr.ndim == 2 and m == 1:
         Yarr = Yarr[:, :, None]

@@ -26,7 +26,7 @@ from ..core.models import NonlinearModel
 from ..core.results import FilterResult, freeze_fields
 from ..core.simulation import as_generator
 from ..tables import Table
-from ..core.validation import KalmanInputError, shape_text
+from ..core.validation import KalmanInputError, as_float_array, shape_text
 from ._motion import cv_process_noise, cv_transition
 
 __all__ = [
@@ -201,7 +201,18 @@ def run_tag_ukf(
 def position_rmse(x_est: Any, x_true: Any, skip: int = TAG_TRANSIENT_STEPS) -> float:
     r"""Erreur quadratique moyenne de position (m), :math:`\sqrt{\frac1{T-s}\sum_{k\ge s}\lVert\hat p_k - p_k\rVert^2}`,
     en ignorant les ``skip`` premiers pas (régime transitoire)."""
-    e = np.asarray(x_est, dtype=float)[skip:, :2] - np.asarray(x_true, dtype=float)[skip:, :2]
+    est, true = as_float_array("x_est", x_est), as_float_array("x_true", x_true)
+    for name, arr in (("x_est", est), ("x_true", true)):
+        if arr.ndim != 2 or arr.shape[1] < 2:
+            raise KalmanInputError(
+                f"« {name} » doit être une suite d'états (T, n), n ≥ 2, la position dans les deux premières "
+                f"colonnes ; reçu {shape_text(arr.shape)}."
+            )
+    if est.shape != true.shape:
+        raise KalmanInputError(
+            f"« x_est » et « x_true » doivent avoir la même forme ; reçu {est.shape} et {true.shape}."
+        )
+    e = est[skip:, :2] - true[skip:, :2]
     if e.shape[0] == 0:
         raise KalmanInputError(f"« skip » = {skip} ne laisse aucun pas pour l'erreur quadratique moyenne.")
     return float(np.sqrt(np.mean(np.sum(e**2, axis=1))))

@@ -1,0 +1,231 @@
+"""Une seule suite pour toute la famille : chaque filtre qui se réduit au filtre de Kalman sur un modèle
+linéaire est comparé à la référence indépendante (la boucle ``predict()``/``update()`` de filterpy) sur les
+mêmes données — mêmes ``x`` et ``P`` à 1e-9, même traitement des mesures manquantes, mêmes erreurs
+d'entrée (elles viennent du moteur commun).
+
+Les filtres à venir (UKF du paquet, filtre particulaire, lisseurs) rejoignent la liste ``FILTERS``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import pytest
+
+import kalman_course as kc
+from conftest import filterpy_kf, random_model
+
+TOL = dict(atol=1e-9, rtol=1e-9)
+
+
+@dataclass(frozen=True)
+class Member:
+    """Un filtre de la famille : ``run(linear_model, y, x0, P0, u)`` → FilterResult."""
+
+    name: str
+    run: Callable
+    partial_rows: bool = True   # accepte une ligne partiellement manquante
+    control: bool = True        # accepte une commande
+
+
+def _nonlinear(model):
+    return kc.NonlinearModel.from_linear(model)
+
+
+def _ukf(model, y, x0, P0, u=None):
+    return kc.filterpy_unscented_filter(_nonlinear(model), y, x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0)
+
+
+FILTERS = [
+    Member("KF", lambda m, y, x0, P0, u=None: kc.kalman_filter(m, y, x0, P0, u)),
+    Member("KF (Joseph)", lambda m, y, x0, P0, u=None: kc.kalman_filter(m, y, x0, P0, u, joseph=True)),
+    Member("KF en lot", lambda m, y, x0, P0, u=None: kc.kalman_filter_runs(m, np.asarray(y)[None], x0, P0, u).run(0)),
+    Member("EKF", lambda m, y, x0, P0, u=None: kc.extended_kalman_filter(_nonlinear(m), y, x0, P0, u)),
+    Member("EKF itéré (1)", lambda m, y, x0, P0, u=None: kc.iterated_extended_kalman_filter(
+        _nonlinear(m), y, x0, P0, u, max_iter=1)),
+    Member("EKF itéré (20)", lambda m, y, x0, P0, u=None: kc.iterated_extended_kalman_filter(_nonlinear(m), y, x0, P0, u)),
+    Member("SRIF (inverse)", lambda m, y, x0, P0, u=None: kc.square_root_information_filter(m, y, x0, P0, u)),
+    Member("SRIF (joint)", lambda m, y, x0, P0, u=None: kc.square_root_information_filter(
+        m, y, x0, P0, u, method="joint")),
+    Member("SRIF étendu", lambda m, y, x0, P0, u=None: kc.extended_square_root_information_filter(
+        _nonlinear(m), y, x0, P0, u)),
+    Member("UKF de filterpy (α=1, β=2, κ=0)", _ukf, partial_rows=False),
+]
+IDS = [f.name for f in FILTERS]
+
+
+def _case(seed: int, n: int, m: int, p: int, T: int = 80):
+    rng = np.random.default_rng(seed)
+    model = random_model(rng, n, m, p)
+    # dynamique stable (rayon spectral 0,95) : l'état reste d'ordre 1 et les arrondis de la moyenne des
+    # points sigma de l'UKF (qui croissent avec |x|² / P) restent négligeables
+    A = 0.95 * model.A / max(1.0, float(np.max(np.abs(np.linalg.eigvals(model.A)))))
+    model = kc.LinearGaussianModel(A, model.C, model.Q, model.R, B=model.B)
+    u = rng.standard_normal((T, p)) if p else None
+    sim = kc.simulate(model, rng.standard_normal(n), T, u=u, rng=rng)
+    return model, np.array(sim.y), rng.standard_normal(n), 2.0 * np.eye(n), u
+
+
+@pytest.mark.parametrize("member", FILTERS, ids=IDS)
+@pytest.mark.parametrize("n,m,p", [(1, 1, 0), (3, 2, 1), (4, 2, 2)])
+def test_equals_filterpy_kalman_filter(member, n, m, p):
+    model, y, x0, P0, u = _case(10 * n + m + p, n, m, p)
+    res = member.run(model, y, x0, P0, u)
+    x, P, xp, Pp = filterpy_kf(model, y, x0, P0, u=u)
+    np.testing.assert_allclose(res.x, x, **TOL)
+    np.testing.assert_allclose(res.P, P, **TOL)
+    np.testing.assert_allclose(res.x_pred, xp, **TOL)
+    np.testing.assert_allclose(res.P_pred, Pp, **TOL)
+    assert isinstance(res, kc.FilterResult) and res.x.shape == (len(y), n) and res.P.shape == (len(y), n, n)
+
+
+@pytest.mark.parametrize("member", FILTERS, ids=IDS)
+def test_missing_rows_are_prediction_only(member):
+    model, y, x0, P0, u = _case(3, 3, 2, 1)
+    y[[0, 7, 8, 40]] = np.nan
+    res = member.run(model, y, x0, P0, u)
+    x, P, xp, Pp = filterpy_kf(model, y, x0, P0, u=u)
+    np.testing.assert_allclose(res.x, x, **TOL)
+    np.testing.assert_allclose(res.P, P, **TOL)
+    for k in (0, 7, 8, 40):  # pas sans mesure : l'estimation est la prédiction, gain nul
+        np.testing.assert_array_equal(res.x[k], res.x_pred[k])
+        assert not res.observed[k].any() and np.all(res.K[k] == 0) and np.isnan(res.innovation[k]).all()
+
+
+@pytest.mark.parametrize("member", [f for f in FILTERS if f.partial_rows], ids=[f.name for f in FILTERS if f.partial_rows])
+def test_partial_rows_use_only_the_observed_components(member):
+    """Référence indépendante : filterpy avec, au pas partiel, la seule ligne observée de C et de R."""
+    model, y, x0, P0, u = _case(5, 3, 2, 1, T=30)
+    y[[4, 12], 1] = np.nan
+    res = member.run(model, y, x0, P0, u)
+    from filterpy.kalman import KalmanFilter
+
+    f = KalmanFilter(dim_x=3, dim_z=2, dim_u=1)
+    f.F, f.B, f.Q = np.array(model.A), np.array(model.B), np.array(model.Q)
+    f.x, f.P = x0.reshape(3, 1), P0.copy()
+    for k in range(len(y)):
+        f.predict(u=u[k].reshape(1, 1))
+        obs = ~np.isnan(y[k])
+        f.update(y[k, obs].reshape(-1, 1), R=np.array(model.R)[np.ix_(obs, obs)], H=np.array(model.C)[obs])
+        np.testing.assert_allclose(res.x[k], f.x.ravel(), **TOL)
+        np.testing.assert_allclose(res.P[k], f.P, **TOL)
+    assert res.observed[4].tolist() == [True, False] and np.isnan(res.innovation[4, 1])
+    assert np.all(res.K[4][:, 1] == 0) and np.isnan(res.S[4][1]).all()
+
+
+def test_ukf_adapter_refuses_partial_rows_with_a_french_error():
+    model, y, x0, P0, u = _case(5, 3, 2, 1, T=10)
+    y[4, 1] = np.nan
+    with pytest.raises(kc.KalmanInputError, match="partiellement manquantes"):
+        _ukf(model, y, x0, P0, u)
+
+
+def test_nis_is_consistent_on_every_member():
+    """Innovation et S de chaque filtre forment une NIS du même filtre linéaire (à 1e-9)."""
+    model, y, x0, P0, u = _case(11, 3, 2, 1)
+    ref = kc.nis(kc.kalman_filter(model, y, x0, P0, u))
+    for member in FILTERS:
+        np.testing.assert_allclose(kc.nis(member.run(model, y, x0, P0, u)), ref, rtol=1e-8, err_msg=member.name)
+
+
+# --------------------------------------------------------------------------- mêmes erreurs d'entrée
+
+BAD_INPUTS = [
+    (dict(y=np.zeros((5, 3))), r"« y » doit être de forme \(T, 2\)"),
+    (dict(y=np.zeros((0, 2))), r"« y » ne contient aucune mesure"),
+    (dict(y=np.full((5, 2), np.inf)), r"« y » contient des valeurs infinies"),
+    (dict(x0=np.zeros(4)), r"« x0 » doit être un vecteur de forme \(3,\) ; reçu la forme \(4,\)"),
+    (dict(x0=np.zeros((3, 1))), r"vecteur colonne"),
+    (dict(P0=-np.eye(3)), r"« P0 » doit être (semi-)?définie positive"),  # définie pour le SRIF étendu
+    (dict(P0=np.ones((3, 2))), r"« P0 » doit être une matrice carrée"),
+    (dict(u=np.zeros((4, 1))), r"« u » doit avoir une commande par pas de temps : 5 ligne\(s\) attendue\(s\), 4"),
+]
+
+
+@pytest.mark.parametrize("member", [f for f in FILTERS if not f.name.startswith(("SRIF (", "KF en lot"))],
+                         ids=[f.name for f in FILTERS if not f.name.startswith(("SRIF (", "KF en lot"))])
+@pytest.mark.parametrize("bad, message", BAD_INPUTS)
+def test_same_bad_input_errors(member, bad, message):
+    model, y, x0, P0, u = _case(1, 3, 2, 1, T=5)
+    args = dict(y=y, x0=x0, P0=P0, u=u)
+    args.update(bad)
+    with pytest.raises(kc.KalmanInputError, match=message):
+        member.run(model, args["y"], args["x0"], args["P0"], args["u"])
+
+
+@pytest.mark.parametrize("bad, message", BAD_INPUTS[:3] + BAD_INPUTS[7:])
+@pytest.mark.parametrize("method", ["inverse", "joint"])
+def test_srif_shares_the_engine_errors(bad, message, method):
+    model, y, x0, P0, u = _case(1, 3, 2, 1, T=5)
+    args = dict(y=y, u=u)
+    args.update(bad)
+    with pytest.raises(kc.KalmanInputError, match=message):
+        kc.square_root_information_filter(model, args["y"], x0, P0, args["u"], method=method)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda m, y: kc.kalman_filter(kc.NonlinearModel.from_linear(m), y, np.zeros(3), np.eye(3)),
+        lambda m, y: kc.extended_kalman_filter(m, y, np.zeros(3), np.eye(3)),
+        lambda m, y: kc.iterated_extended_kalman_filter(m, y, np.zeros(3), np.eye(3)),
+        lambda m, y: kc.square_root_information_filter(kc.NonlinearModel.from_linear(m), y),
+        lambda m, y: kc.extended_square_root_information_filter(m, y, np.zeros(3), np.eye(3)),
+        lambda m, y: kc.kalman_filter_runs(kc.NonlinearModel.from_linear(m), y[None], np.zeros(3), np.eye(3)),
+    ],
+)
+def test_wrong_model_type_is_named_with_a_hint(call):
+    model, y, *_ = _case(1, 3, 2, 0, T=5)
+    with pytest.raises(kc.KalmanInputError, match=r"« model » doit être un \w+ ; reçu \w+ \(pour un modèle"):
+        call(model, y)
+
+
+def test_control_without_B_is_refused_by_every_member():
+    model, y, x0, P0, _ = _case(1, 3, 2, 0, T=5)
+    for member in FILTERS:
+        with pytest.raises(kc.KalmanInputError, match="« u » est fourni mais le modèle n'a pas de matrice de commande B"):
+            member.run(model, y, x0, P0, np.zeros((5, 1)))
+
+
+# --------------------------------------------------------------------------- tirages en lot
+
+
+@pytest.mark.parametrize("missing", [False, True])
+def test_runs_equal_kalman_filter_run_by_run(missing):
+    rng = np.random.default_rng(8)
+    model = _case(8, 4, 2, 1)[0]
+    N, T = 12, 40
+    U = rng.standard_normal((T, 1))
+    Y = np.stack([kc.simulate(model, rng.standard_normal(4), T, U, rng=rng).y for _ in range(N)])
+    X0 = rng.standard_normal((N, 4))
+    if missing:
+        Y[rng.random((N, T)) < 0.15] = np.nan          # lignes entières
+        Y[:, :, 1][rng.random((N, T)) < 0.2] = np.nan  # composantes isolées
+    runs = kc.kalman_filter_runs(model, Y, X0, np.eye(4), U)
+    assert runs.x.shape == (N, T, 4)
+    assert runs.shared_covariance is (not missing)
+    assert runs.P.shape == ((T, 4, 4) if not missing else (N, T, 4, 4))
+    for r in range(N):
+        ref = kc.kalman_filter(model, Y[r], X0[r], np.eye(4), U)
+        one = runs.run(r)
+        for field in ("x", "P", "x_pred", "P_pred", "K", "innovation", "S"):
+            np.testing.assert_allclose(getattr(one, field), getattr(ref, field), rtol=1e-12, atol=1e-12,
+                                       err_msg=field)
+        np.testing.assert_array_equal(one.observed, ref.observed)
+        np.testing.assert_array_equal(one.n_iter, ref.n_iter)
+
+
+def test_runs_bad_input():
+    rng = np.random.default_rng(2)
+    model = random_model(rng, 2, 1, 0)
+    with pytest.raises(kc.KalmanInputError, match=r"« Y » doit être de forme \(N, T, 1\) ou \(N, T\)"):
+        kc.kalman_filter_runs(model, np.zeros(5), np.zeros(2), np.eye(2))
+    with pytest.raises(kc.KalmanInputError, match=r"« x0 » doit être de forme \(2,\) \(commun\) ou \(3, 2\)"):
+        kc.kalman_filter_runs(model, np.zeros((3, 5)), np.zeros((4, 2)), np.eye(2))
+    with pytest.raises(kc.KalmanInputError, match=r"« u » est fourni mais le modèle n'a pas de matrice de commande B"):
+        kc.kalman_filter_runs(model, np.zeros((3, 5)), np.zeros(2), np.eye(2), u=np.zeros(5))
+    runs = kc.kalman_filter_runs(model, np.zeros((3, 5)), np.zeros(2), np.eye(2))
+    with pytest.raises(kc.KalmanInputError, match="« i » doit être un indice de tirage"):
+        runs.run(3)
