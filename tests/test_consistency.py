@@ -34,17 +34,9 @@ def _consistent_run(model, T, seed):
 
 
 def _engine_results(T=500):
-    model = engine.engine_model()
-    u = engine.engine_commands(T)
-    sim = kc.simulate(model, engine.ENGINE_X0_MEAN, T, u, rng=engine.ENGINE_SEED)
-    incomplete = kc.LinearGaussianModel(np.diag(np.diag(model.A)), model.C, model.Q, model.R, B=model.B)
-    filters = {
-        "juste": model,
-        "psi_petit": engine.engine_model(Psi=engine.ENGINE_PSI / 10),
-        "phi_grand": engine.engine_model(Phi=10 * engine.ENGINE_PHI),
-        "incomplet": incomplete,
-    }
-    return sim, {k: kc.kalman_filter(m, sim.y, engine.ENGINE_X0_HAT, engine.ENGINE_P0, u) for k, m in filters.items()}
+    """Le banc d'essai du chapitre (scénario du moteur), clés courtes."""
+    sim, results = engine.consistency_runs(T)
+    return sim, dict(zip(["juste", "psi_petit", "phi_grand", "incomplet"], results.values()))
 
 
 # --------------------------------------------------------------------------- NIS et NEES : formules
@@ -327,17 +319,6 @@ def test_centring_test_matches_student_and_a_direct_hotelling_computation():
     np.testing.assert_allclose(test.mean, mean)
     assert not kc.centring_test(rng.standard_normal((400, 2)) + 0.3).centred
     assert kc.centring_test(rng.standard_normal((400, 2))).centred
-
-
-def test_chapter_figures_use_the_same_runs_as_the_tests():
-    """Les figures du chapitre et ses nombres (même construction que ``_engine_results``) coïncident."""
-    from kalman_course.figures import consistency as figs
-
-    sim, results = figs.chapter_runs()
-    ref_sim, ref = _engine_results()
-    np.testing.assert_array_equal(sim.y, ref_sim.y)
-    for (name, res), key in zip(results.items(), ["juste", "psi_petit", "phi_grand", "incomplet"]):
-        np.testing.assert_array_equal(res.x, ref[key].x), name
 
 
 def test_consistency_table_lists_each_filter():

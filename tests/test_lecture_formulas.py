@@ -108,7 +108,7 @@ def test_linear_estimator_with_conditions_is_the_kalman_filter_and_filterpy():
 @pytest.mark.parametrize("forget_command", [False, True])
 def test_mean_error_recursion_matches_monte_carlo(forget_command):
     """L'expérience de la figure « estimateur-erreur-moyenne »."""
-    from kalman_course.figures.estimator import mean_error_experiment
+    from kalman_course.scenarios.engine import mean_error_experiment
 
     mc, rec = mean_error_experiment(forget_command)
     np.testing.assert_allclose(rec.e, rec.x_hat - rec.x, atol=1e-9)
@@ -194,7 +194,7 @@ def test_gains_do_not_depend_on_measurements():
 
 def test_posterior_coverage_experiment():
     """L'expérience de la figure « gain-loi-a-posteriori » : N(x̂_n, P_n) couvre à 95 %."""
-    from kalman_course.figures.gain import posterior_experiment
+    from kalman_course.scenarios.voltage import posterior_experiment
 
     mc, P = posterior_experiment(n_steps=50, n_runs=2000)
     z = (mc.x[:, :, 0] - mc.x_hat[:, :, 0]) / np.sqrt(P)

@@ -49,24 +49,6 @@ def _hat(xi):
     return np.array([[0, -w[2], w[1], r[0]], [w[2], 0, -w[0], r[1]], [-w[1], w[0], 0, r[2]], [0, 0, 0, 0.0]])
 
 
-def _pixels(T, points, cam):
-    Pc = points @ T[:3, :3].T + T[:3, 3]
-    return np.column_stack([cam.fx * Pc[:, 0] / Pc[:, 2] + cam.cx, cam.fy * Pc[:, 1] / Pc[:, 2] + cam.cy]).ravel()
-
-
-def _least_squares_pose(p, with_prior=True):
-    """MAP (ou ajustement aux seules mesures) par least_squares sur T = T̂₋ expm(ξ^), jacobienne 3 points."""
-    LP = np.linalg.cholesky(p.P_pred)
-
-    def res(xi):
-        T = p.T_pred @ scipy.linalg.expm(_hat(xi))
-        r = (p.y - _pixels(T, p.points, p.camera)) / p.sigma_px
-        return np.concatenate([np.linalg.solve(LP, xi), r]) if with_prior else r
-
-    sol = scipy.optimize.least_squares(res, np.zeros(6), jac="3-point", xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    return p.T_pred @ scipy.linalg.expm(_hat(sol.x))
-
-
 def _distance(T1, T0):
     return float(np.linalg.norm(lie.se3_log(np.linalg.inv(T0) @ T1)))
 
@@ -149,7 +131,7 @@ def test_scenario_matches_the_specification(problem):
 
 
 def test_converged_pose_is_the_independent_map(problem, solved):
-    T_map = _least_squares_pose(problem)
+    T_map = ct.camera_map_estimate(problem)
     assert solved.converged and solved.n_iter <= 10
     assert _distance(solved.T, T_map) <= 1e-6
     assert _distance(ct.camera_map_estimate(problem), T_map) <= 1e-6  # le MAP du scénario aussi
@@ -167,7 +149,7 @@ def test_one_iteration_is_the_manifold_ekf(problem):
     P = problem.P_pred
     S = H @ P @ H.T + np.eye(20)
     K = np.linalg.solve(S, H @ P).T
-    d = K @ (problem.y - _pixels(problem.T_pred, problem.points, problem.camera))
+    d = K @ (problem.y - ct.reference_pixels(problem.T_pred, problem.points, problem.camera))
     J = lie.se3_right_jacobian(d)
     P_post = J @ (np.eye(6) - K @ H) @ P @ J.T
     for res in (one, ekf):
@@ -189,8 +171,8 @@ def test_embedded_whitened_step_equals_the_iekf_step_and_scalar_weights_do_not(p
 def test_notes_loop_drops_the_prior_and_fits_the_measurements_only(problem):
     its = errata_se3.notes_literal_iterates(problem.T_pred, problem.P_pred, problem.y, problem.points,
                                            problem.camera, problem.sigma_px)
-    T_meas = _least_squares_pose(problem, with_prior=False)
-    T_map = _least_squares_pose(problem)
+    T_meas = ct.camera_measurement_only_fit(problem)
+    T_map = ct.camera_map_estimate(problem)
     assert _distance(its[-1], T_meas) <= 1e-6
     assert _distance(its[-1], T_map) > 1e-4
     assert _distance(ct.camera_measurement_only_fit(problem), T_meas) <= 1e-6
@@ -199,7 +181,7 @@ def test_notes_loop_drops_the_prior_and_fits_the_measurements_only(problem):
 def test_identity_jacobian_variant_misses_the_map(problem):
     approx = problem.iekf(use_right_jacobian=False)
     assert approx.converged
-    assert _distance(approx.T, _least_squares_pose(problem)) > 1e-6
+    assert _distance(approx.T, ct.camera_map_estimate(problem)) > 1e-6
 
 
 def test_posterior_covariance_is_symmetric_and_shrinks(solved, problem):

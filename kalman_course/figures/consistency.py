@@ -16,72 +16,13 @@ from ..diagnostics.consistency import (
     whitened_innovations,
     whiteness_test,
 )
-from ..filters.kalman import kalman_filter
-from ..core.models import LinearGaussianModel
-from ..scenarios.engine import (
-    ENGINE_DT,
-    ENGINE_P0,
-    ENGINE_PHI,
-    ENGINE_PSI,
-    ENGINE_SEED,
-    ENGINE_X0_COV,
-    ENGINE_X0_HAT,
-    ENGINE_X0_MEAN,
-    engine_commands,
-    engine_model,
-)
-from ..core.simulation import simulate
-from ..diagnostics.monte_carlo import monte_carlo_consistency
+from ..scenarios.engine import CONSISTENCY_MC_RUNS, CONSISTENCY_MC_STEPS, ENGINE_DT, consistency_monte_carlo, consistency_runs
 from ._registry import new_figure, register
 
 CHAPTER = "tests-statistiques"
 
-#: Durée des relevés du chapitre (pas d'une seconde).
-N_STEPS = 500
-#: Monte-Carlo de la NEES : nombre de tirages, durée, graine.
-MC_RUNS, MC_STEPS, MC_SEED = 100, 100, 2001
 #: Décalage maximal des autocorrélations.
 MAX_LAG = 20
-
-
-def incomplete_engine_model() -> LinearGaussianModel:
-    r"""Le moteur sans couplage thermique : :math:`A = \operatorname{diag}(0{,}95 ; 0{,}96)` au lieu de
-    la matrice pleine du système (les termes 0,03 et 0,02 sont oubliés) ; le reste est juste."""
-    model = engine_model()
-    return LinearGaussianModel(np.diag(np.diag(model.A)), model.C, model.Q, model.R, B=model.B)
-
-
-def chapter_filters() -> dict[str, LinearGaussianModel]:
-    """Les quatre filtres du chapitre, par nom affiché (ordre des figures et du tableau)."""
-    return {
-        "modèle juste": engine_model(),
-        "Ψ ÷ 10": engine_model(Psi=ENGINE_PSI / 10),
-        "Φ × 10": engine_model(Phi=10 * ENGINE_PHI),
-        "couplage oublié": incomplete_engine_model(),
-    }
-
-
-def chapter_runs(n_steps: int = N_STEPS):
-    """Le moteur simulé une fois (modèle vrai, graine du scénario), filtré par chacun des filtres de
-    :func:`chapter_filters` ; renvoie ``(simulation, {nom: FilterResult})``."""
-    true = engine_model()
-    u = engine_commands(n_steps)
-    sim = simulate(true, ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
-    results = {name: kalman_filter(m, sim.y, ENGINE_X0_HAT, ENGINE_P0, u) for name, m in chapter_filters().items()}
-    return sim, results
-
-
-def chapter_monte_carlo():
-    r"""NEES et NIS de :data:`MC_RUNS` tirages (:data:`MC_STEPS` pas) pour le modèle juste et les deux
-    réglages faux ; initialisation cohérente :math:`x_0 \sim \mathcal N(\hat x_0, P_0)`."""
-    true = engine_model()
-    u = engine_commands(MC_STEPS)
-    filters = chapter_filters()
-    return {
-        name: monte_carlo_consistency(true, MC_STEPS, MC_RUNS, x0_hat=ENGINE_X0_MEAN, P0=ENGINE_X0_COV,
-                                      rng=MC_SEED, filter_model=filters[name], u=u)
-        for name in ("modèle juste", "Ψ ÷ 10", "Φ × 10")
-    }
 
 
 #: Titres des panneaux : le nom court du filtre et ce qu'il a de faux.
@@ -102,7 +43,7 @@ _COLORS = {
 
 @register("tests-nis-loi", chapter=CHAPTER, title="Distribution de la NIS du modèle juste et loi du χ² à 2 degrés")
 def nis_distribution_figure():
-    _, results = chapter_runs()
+    _, results = consistency_runs()
     values = nis(results["modèle juste"])
     fig, ax = new_figure(width=7.0, height=3.4)
     edges = np.linspace(0.0, 12.0, 31)
@@ -120,7 +61,7 @@ def nis_distribution_figure():
 
 @register("tests-nis", chapter=CHAPTER, title="NIS au cours du temps : filtre bien ou mal réglé")
 def nis_figure():
-    _, results = chapter_runs()
+    _, results = consistency_runs()
     names = ["modèle juste", "Ψ ÷ 10", "Φ × 10"]
     fig, axes = new_figure(3, 1, width=7.0, height=7.2, sharex=True, sharey=True)
     step_lo, step_hi = chi2_band(2, 1)
@@ -144,10 +85,10 @@ def nis_figure():
 
 @register("tests-nees", chapter=CHAPTER, title="NEES moyenne de 100 tirages de Monte-Carlo et sa bande du χ²")
 def nees_figure():
-    runs = chapter_monte_carlo()
+    runs = consistency_monte_carlo()
     fig, ax = new_figure(width=7.0, height=3.8)
-    lo, hi = chi2_band(2, MC_RUNS)
-    t = ENGINE_DT * np.arange(1, MC_STEPS + 1)
+    lo, hi = chi2_band(2, CONSISTENCY_MC_RUNS)
+    t = ENGINE_DT * np.arange(1, CONSISTENCY_MC_STEPS + 1)
     ax.axhspan(lo, hi, color="tab:green", alpha=0.3, label=f"bande à 95 % de la moyenne [{lo:.2f} ; {hi:.2f}]")
     ax.axhline(2.0, color="0.3", lw=0.8, ls="--", label="espérance d = 2 (dimension de l'état)")
     for name, run in runs.items():
@@ -157,7 +98,7 @@ def nees_figure():
     ax.set_yticks([1, 2, 5, 10, 20, 50], labels=["1", "2", "5", "10", "20", "50"])
     ax.set_yticks([], minor=True)
     ax.set_xlabel("temps (s)")
-    ax.set_ylabel(f"NEES moyenne sur {MC_RUNS} tirages (sans unité)")
+    ax.set_ylabel(f"NEES moyenne sur {CONSISTENCY_MC_RUNS} tirages (sans unité)")
     ax.set_title("NEES : erreur vraie comparée à la covariance P annoncée par le filtre", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper right", ncol=2)
@@ -167,7 +108,7 @@ def nees_figure():
 @register("tests-autocorrelation", chapter=CHAPTER,
           title="Autocorrélation des innovations blanchies et bande ± 1,96/√T")
 def autocorrelation_figure():
-    _, results = chapter_runs()
+    _, results = consistency_runs()
     names = ["modèle juste", "Ψ ÷ 10", "couplage oublié"]
     fig, axes = new_figure(3, 1, width=7.0, height=7.2, sharex=True, sharey=True)
     for ax, name in zip(axes, names):
@@ -191,7 +132,7 @@ def autocorrelation_figure():
 
 @register("tests-centrage", chapter=CHAPTER, title="Moyenne cumulée des innovations blanchies")
 def centring_figure():
-    _, results = chapter_runs()
+    _, results = consistency_runs()
     names = ["modèle juste", "couplage oublié"]
     fig, axes = new_figure(1, 2, width=7.5, height=3.4, sharey=False)
     for ax, name in zip(axes, names):
@@ -214,15 +155,4 @@ def centring_figure():
     return fig
 
 
-__all__ = [
-    "CHAPTER",
-    "MAX_LAG",
-    "MC_RUNS",
-    "MC_SEED",
-    "MC_STEPS",
-    "N_STEPS",
-    "chapter_filters",
-    "chapter_monte_carlo",
-    "chapter_runs",
-    "incomplete_engine_model",
-]
+__all__ = ["CHAPTER", "MAX_LAG"]

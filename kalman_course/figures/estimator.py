@@ -5,61 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..lecture.estimator import linear_estimator, mean_error_recursion
-from ..filters.kalman import kalman_filter
 from ..core.models import LinearGaussianModel
-from ..scenarios.engine import (
-    ENGINE_DT,
-    ENGINE_SEED,
-    ENGINE_X0_COV,
-    ENGINE_X0_HAT,
-    ENGINE_X0_MEAN,
-    engine_commands,
-    engine_model,
-)
-from ..core.simulation import simulate
+from ..scenarios.engine import ENGINE_DT, mean_error_experiment
 from ..diagnostics.monte_carlo import monte_carlo
 from ._registry import new_figure, register
 
 CHAPTER = "estimateur"
-
-#: Taille des expériences de Monte-Carlo du chapitre.
-N_RUNS = 400
-N_STEPS = 60
-#: Covariance initiale du filtre dans ce chapitre (°C²) : le filtre se croit précis à 1 °C près alors que
-#: son estimation initiale ENGINE_X0_HAT est fausse de 15 °C ; l'erreur moyenne décroît donc sur plusieurs pas.
-OVERCONFIDENT_P0 = np.eye(2)
-
-
-def engine_kalman_gains(n_steps: int = N_STEPS) -> np.ndarray:
-    """Gains du filtre de Kalman du moteur, (T, 2, 2) : ils ne dépendent pas des mesures (une seule course suffit)."""
-    model = engine_model()
-    u = engine_commands(n_steps)
-    y = simulate(model, ENGINE_X0_MEAN, n_steps, u, rng=0).y
-    return kalman_filter(model, y, ENGINE_X0_HAT, OVERCONFIDENT_P0, u).K
-
-
-def mean_error_experiment(forget_command: bool, n_steps: int = N_STEPS, n_runs: int = N_RUNS):
-    """Erreur moyenne de l'estimateur du moteur : Monte-Carlo et récurrence du cours.
-
-    ``forget_command=False`` : le filtre de Kalman (conditions suffisantes respectées) ;
-    ``True`` : mêmes gains mais :math:`B_f = 0` (condition 1 violée : l'estimateur oublie la commande).
-    Renvoie ``(monte_carlo, recursion)``.
-    """
-    model = engine_model()
-    u = engine_commands(n_steps)
-    K = engine_kalman_gains(n_steps)
-    B_f = np.zeros((2, 1)) if forget_command else None
-
-    def estimator(y):
-        return linear_estimator(model, y, ENGINE_X0_HAT, K, u=u, B_f=B_f)
-
-    mc = monte_carlo(
-        model, estimator, n_steps, n_runs,
-        x0_mean=ENGINE_X0_MEAN, x0_cov=ENGINE_X0_COV, x0_hat=ENGINE_X0_HAT, rng=ENGINE_SEED, u=u,
-    )
-    rec = mean_error_recursion(model, K, x0_mean=ENGINE_X0_MEAN, x0_hat=ENGINE_X0_HAT, u=u, B_f=B_f)
-    return mc, rec
-
 
 def _mean_error_panel(ax, mc, rec, title: str) -> None:
     t = ENGINE_DT * np.arange(rec.e.shape[0])

@@ -13,7 +13,6 @@ from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_vo
 from ..scenarios.engine import (
     ENGINE_DT,
     ENGINE_P0,
-    ENGINE_PSI,
     ENGINE_SEED,
     ENGINE_X0_HAT,
     ENGINE_X0_MEAN,
@@ -21,41 +20,12 @@ from ..scenarios.engine import (
     engine_model,
 )
 from ..core.simulation import simulate
-from ..diagnostics.monte_carlo import monte_carlo
+from ..scenarios.engine import LIMIT_SCALES, gain_limit_run, gain_limit_sweep
+from ..scenarios.voltage import posterior_experiment
 from ._registry import new_figure, register
 
 CHAPTER_LOOP = "predicteur-correcteur"
 CHAPTER_OPTIMAL = "gain-optimal"
-
-#: Facteurs appliqués à la covariance de mesure Ψ du filtre pour montrer les deux limites du gain.
-LIMIT_SCALES = (1e6, 1e-6)
-
-
-def gain_limit_run(scale: float, n_steps: int = 120):
-    r"""Moteur simulé avec le vrai :math:`\Psi`, filtré en supposant :math:`s\,\Psi` (``scale`` = :math:`s`).
-
-    Renvoie ``(simulation, FilterResult)``. :math:`s \to \infty` : :math:`K \to 0` ;
-    :math:`s \to 0` : :math:`K \to C^{-1}` (ici :math:`C` est inversible sans être l'identité).
-    """
-    u = engine_commands(n_steps)
-    sim = simulate(engine_model(), ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
-    result = kalman_filter(engine_model(Psi=scale * ENGINE_PSI), sim.y, ENGINE_X0_HAT, ENGINE_P0, u)
-    return sim, result
-
-
-def gain_limit_sweep(scales=None, n_steps: int = 120):
-    r"""Gain final :math:`K_T` en fonction du facteur :math:`s` : renvoie ``(scales, ‖K‖/‖C⁻¹‖, ‖K − C⁻¹‖/‖C⁻¹‖)``
-    (normes de Frobenius)."""
-    scales = np.logspace(-8, 8, 33) if scales is None else np.asarray(scales, dtype=float)
-    C_inv = scipy.linalg.inv(engine_model().C)
-    norm = np.linalg.norm(C_inv)
-    to_zero, to_inverse = [], []
-    for s in scales:
-        K = gain_limit_run(float(s), n_steps)[1].K[-1]
-        to_zero.append(np.linalg.norm(K) / norm)
-        to_inverse.append(np.linalg.norm(K - C_inv) / norm)
-    return scales, np.array(to_zero), np.array(to_inverse)
-
 
 @register("gain-limites", chapter=CHAPTER_LOOP, title="Limites du gain : K → 0 et K → C⁻¹")
 def gain_limits_figure():
@@ -164,27 +134,6 @@ def trace_figure():
     ax2.legend(fontsize=8, loc="upper center")
     ax2.grid(alpha=0.3)
     return fig
-
-
-#: Expérience de la loi a posteriori : tension constante tirée de N(0, 1), filtre exactement informé.
-POSTERIOR_RUNS = 2000
-POSTERIOR_SEED = 1961
-
-
-def posterior_experiment(n_steps: int = 50, n_runs: int = POSTERIOR_RUNS):
-    r"""Monte-Carlo de la loi a posteriori :math:`p(x_n\mid y_1\dots y_n) = \mathcal N(\hat x_n, P_n)`.
-
-    Tension :math:`x_0 \sim \mathcal N(0, 1)` qui dérive avec :math:`\Phi = 10^{-5}`, mesures avec
-    :math:`\Psi = 0{,}01` ; le filtre part de :math:`\hat x_0 = 0`, :math:`P_0 = 1` (son a priori est exact).
-    Renvoie ``(monte_carlo, P)`` avec ``P`` (T,) les variances du filtre (identiques pour tous les tirages).
-    """
-    model = constant_voltage_model()
-    mc = monte_carlo(
-        model, lambda y: kalman_filter(model, y, 0.0, 1.0).x, n_steps, n_runs,
-        x0_mean=0.0, x0_cov=1.0, x0_hat=0.0, rng=POSTERIOR_SEED,
-    )
-    P = kalman_filter(model, mc.y[0], 0.0, 1.0).P[:, 0, 0]
-    return mc, P
 
 
 @register("gain-loi-a-posteriori", chapter=CHAPTER_OPTIMAL, title="La loi a posteriori N(x̂ₙ, Pₙ) vérifiée par Monte-Carlo")

@@ -38,6 +38,7 @@ __all__ = [
     "camera_target_problem",
     "pose_error",
     "camera_map_estimate",
+    "reference_pixels",
     "camera_measurement_only_fit",
     "camera_iteration_table",
     "CameraMonteCarlo",
@@ -128,10 +129,17 @@ def _expm_pose(T0: np.ndarray, xi: np.ndarray) -> np.ndarray:
     return T0 @ scipy.linalg.expm(X)
 
 
+def reference_pixels(T: np.ndarray, points: np.ndarray, camera: PinholeCamera) -> np.ndarray:
+    r"""Pixels :math:`[u_1, v_1, \dots]` (2N,) de la pose ``T``, écrits ici **indépendamment** de
+    :mod:`kalman_course.geometry.camera` : c'est la projection des références (MAP par ``least_squares``,
+    EKF recalculé dans les tests) qui contrôlent le filtre."""
+    Pc = points @ T[:3, :3].T + T[:3, 3]
+    return np.column_stack([camera.fx * Pc[:, 0] / Pc[:, 2] + camera.cx,
+                            camera.fy * Pc[:, 1] / Pc[:, 2] + camera.cy]).ravel()
+
+
 def _pixels(T: np.ndarray, problem: CameraTargetProblem) -> np.ndarray:
-    Pc = problem.points @ T[:3, :3].T + T[:3, 3]
-    cam = problem.camera
-    return np.column_stack([cam.fx * Pc[:, 0] / Pc[:, 2] + cam.cx, cam.fy * Pc[:, 1] / Pc[:, 2] + cam.cy]).ravel()
+    return reference_pixels(T, problem.points, problem.camera)
 
 
 def _solve(residuals, problem: CameraTargetProblem) -> np.ndarray:

@@ -37,6 +37,7 @@ __all__ = [
     "DIFFUSE_P0_EXPONENTS",
     "diffuse_model",
     "diffuse_data",
+    "batch_least_squares",
     "batch_estimates",
     "extended_precision_estimates",
     "DiffuseErrors",
@@ -75,34 +76,59 @@ def diffuse_data(n_steps: int = DIFFUSE_N_STEPS, rng=DIFFUSE_SEED):
     return x, y
 
 
+def batch_least_squares(A: np.ndarray, C: np.ndarray, LR: np.ndarray, G: np.ndarray, y: np.ndarray, *,
+                        La: np.ndarray | None = None, B: np.ndarray | None = None,
+                        u: np.ndarray | None = None) -> np.ndarray:
+    r"""Estimations exactes **sans a priori**, par moindres carrés pondérés en bloc (``scipy.linalg.lstsq``) :
+    la référence indépendante du SRIF parti de :math:`\mathcal R_{xx} = 0`.
+
+    Modèle :math:`x_{j+1} = Ax_j + Bu_j + Ga_j`, :math:`a_j \sim \mathcal N(0, L_aL_a^T)` (``La`` triangulaire
+    inférieure, identité par défaut), :math:`y_j = Cx_j + v_j`, :math:`v_j \sim \mathcal N(0, L_RL_R^T)`
+    (``LR`` triangulaire inférieure). Pour chaque :math:`k` : inconnues
+    :math:`\theta = [x_1, a_1, \dots, a_{k-1}]` (état au premier relevé, bruits),
+    :math:`x_j = \Phi_j\theta + o_j` ; équations blanchies :math:`L_R^{-1}(Cx_j - y_j)` et
+    :math:`L_a^{-1}a_i`. Renvoie
+    :math:`\hat x_{k\mid k} = x_k(\hat\theta)`, forme (T, n) ; NaN tant que le système est de rang
+    insuffisant (pas assez de relevés pour déterminer tout l'état).
+    """
+    n, q = A.shape[0], G.shape[1]
+    T = y.shape[0]
+    La = np.eye(q) if La is None else La
+    out = np.full((T, n), np.nan)
+    for k in range(1, T + 1):
+        n_theta = n + q * (k - 1)
+        # Phi[j], off[j] : x_j = Phi[j] θ + off[j] (j = 0 … k-1)
+        Phi = np.zeros((k, n, n_theta))
+        off = np.zeros((k, n))
+        Phi[0, :, :n] = np.eye(n)
+        for j in range(1, k):
+            Phi[j] = A @ Phi[j - 1]
+            Phi[j, :, n + q * (j - 1):n + q * j] += G
+            if B is not None:
+                off[j] = A @ off[j - 1] + B @ u[j]
+        rows = [scipy.linalg.solve_triangular(LR, C @ Phi[j], lower=True) for j in range(k)]
+        rhs = [scipy.linalg.solve_triangular(LR, y[j] - C @ off[j], lower=True) for j in range(k)]
+        noise_rows = np.zeros((q * (k - 1), n_theta))
+        for i in range(k - 1):
+            noise_rows[q * i:q * (i + 1), n + q * i:n + q * (i + 1)] = scipy.linalg.solve_triangular(La, np.eye(q), lower=True)
+        rows.append(noise_rows)
+        rhs.append(np.zeros(q * (k - 1)))
+        M = np.vstack(rows)
+        if np.linalg.matrix_rank(M) < n_theta:
+            continue
+        theta = scipy.linalg.lstsq(M, np.concatenate(rhs))[0]
+        out[k - 1] = Phi[k - 1] @ theta + off[k - 1]
+    return out
+
+
 def batch_estimates(y: np.ndarray, accel_std: float = DIFFUSE_ACCEL_STD, fix_std: float = DIFFUSE_FIX_STD,
                     dt: float = DIFFUSE_DT) -> np.ndarray:
-    r"""Estimations exactes sans a priori, par moindres carrés pondérés en bloc (``scipy.linalg.lstsq``).
-
-    Pour chaque :math:`k \ge 2` : inconnues :math:`\theta = [x_1, a_1, \dots, a_{k-1}]` (état au premier
-    relevé, accélérations), :math:`x_j = F^{j-1}x_1 + \sum_{i<j} F^{j-1-i}Ga_i` ; équations blanchies
-    :math:`(Cx_j - y_j)/\sigma` et :math:`a_i/\sigma_a`. Renvoie :math:`\hat x_{k\mid k} = x_k(\hat\theta)`,
-    forme (T, 4) (ligne 0 : NaN, un seul relevé ne donne pas la vitesse).
-    """
-    F, G = cv_transition(dt), _cv_noise_gain(dt)
+    r""":func:`batch_least_squares` sur le scénario (accélérations :math:`a \sim \mathcal N(0, \sigma_a^2 I)`,
+    positions mesurées à :math:`\sigma` près), forme (T, 4) (ligne 0 : NaN, un seul relevé ne donne pas
+    la vitesse)."""
     C = np.hstack([np.eye(2), np.zeros((2, 2))])
-    T = y.shape[0]
-    out = np.full((T, 4), np.nan)
-    for k in range(2, T + 1):
-        n_theta = 4 + 2 * (k - 1)
-        # Phi[j] : x_j = Phi[j] θ (j = 0 … k-1)
-        Phi = np.zeros((k, 4, n_theta))
-        Phi[0, :, :4] = np.eye(4)
-        for j in range(1, k):
-            Phi[j] = F @ Phi[j - 1]
-            Phi[j, :, 4 + 2 * (j - 1):4 + 2 * j] += G
-        rows = [C @ Phi[j] / fix_std for j in range(k)]
-        rhs = [y[j] / fix_std for j in range(k)]
-        rows.append(np.hstack([np.zeros((2 * (k - 1), 4)), np.eye(2 * (k - 1)) / accel_std]))
-        rhs.append(np.zeros(2 * (k - 1)))
-        theta = scipy.linalg.lstsq(np.vstack(rows), np.concatenate(rhs))[0]
-        out[k - 1] = Phi[k - 1] @ theta
-    return out
+    return batch_least_squares(cv_transition(dt), C, fix_std * np.eye(2), _cv_noise_gain(dt), y,
+                               La=accel_std * np.eye(2))
 
 
 def extended_precision_estimates(model: LinearGaussianModel, y: np.ndarray, p0_exponent: int = 40,

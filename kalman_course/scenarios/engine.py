@@ -20,8 +20,14 @@ mesures (mV). Il est inversible sans être l'identité, ce qui sert à illustrer
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg
 
 from ..core.models import LinearGaussianModel
+from ..core.simulation import Simulation, simulate
+from ..diagnostics.monte_carlo import ConsistencyRuns, MonteCarlo, monte_carlo, monte_carlo_consistency
+from ..filters.kalman import kalman_filter
+from ..lecture.estimator import MeanError, linear_estimator, mean_error_recursion
+from ..core.results import FilterResult
 
 __all__ = [
     "ENGINE_DT",
@@ -36,6 +42,22 @@ __all__ = [
     "ENGINE_X0_MEAN",
     "engine_commands",
     "engine_model",
+    "OVERCONFIDENT_P0",
+    "MEAN_ERROR_RUNS",
+    "MEAN_ERROR_STEPS",
+    "engine_kalman_gains",
+    "mean_error_experiment",
+    "LIMIT_SCALES",
+    "gain_limit_run",
+    "gain_limit_sweep",
+    "CONSISTENCY_STEPS",
+    "CONSISTENCY_MC_RUNS",
+    "CONSISTENCY_MC_STEPS",
+    "CONSISTENCY_MC_SEED",
+    "incomplete_engine_model",
+    "consistency_filters",
+    "consistency_runs",
+    "consistency_monte_carlo",
 ]
 
 #: Durée d'un pas de temps (s).
@@ -84,3 +106,129 @@ def engine_commands(n_steps: int = 120) -> np.ndarray:
     u = np.where(t >= 10, 5.0, 0.0)
     u = np.where(t >= 70, 2.0, u)
     return u.reshape(-1, 1)
+
+
+# --------------------------------------------------------------------------- « Construction d'un estimateur »
+
+#: Covariance initiale du filtre dans le chapitre de l'estimateur (°C²) : le filtre se croit précis à 1 °C
+#: près alors que son estimation initiale ENGINE_X0_HAT est fausse de 15 °C ; l'erreur moyenne décroît donc
+#: sur plusieurs pas.
+OVERCONFIDENT_P0 = np.eye(2)
+#: Taille des expériences de Monte-Carlo de l'erreur moyenne.
+MEAN_ERROR_RUNS = 400
+MEAN_ERROR_STEPS = 60
+
+
+def engine_kalman_gains(n_steps: int = MEAN_ERROR_STEPS) -> np.ndarray:
+    """Gains du filtre de Kalman du moteur (parti de ENGINE_X0_HAT, OVERCONFIDENT_P0), (T, 2, 2) : ils ne
+    dépendent pas des mesures (une seule course suffit)."""
+    model = engine_model()
+    u = engine_commands(n_steps)
+    y = simulate(model, ENGINE_X0_MEAN, n_steps, u, rng=0).y
+    return kalman_filter(model, y, ENGINE_X0_HAT, OVERCONFIDENT_P0, u).K
+
+
+def mean_error_experiment(forget_command: bool, n_steps: int = MEAN_ERROR_STEPS,
+                          n_runs: int = MEAN_ERROR_RUNS) -> tuple[MonteCarlo, MeanError]:
+    """Erreur moyenne de l'estimateur du moteur : Monte-Carlo et récurrence du cours.
+
+    ``forget_command=False`` : le filtre de Kalman (conditions suffisantes respectées) ;
+    ``True`` : mêmes gains mais :math:`B_f = 0` (condition 1 violée : l'estimateur oublie la commande).
+    Renvoie ``(monte_carlo, recursion)``.
+    """
+    model = engine_model()
+    u = engine_commands(n_steps)
+    K = engine_kalman_gains(n_steps)
+    B_f = np.zeros((2, 1)) if forget_command else None
+
+    def estimator(y):
+        return linear_estimator(model, y, ENGINE_X0_HAT, K, u=u, B_f=B_f)
+
+    mc = monte_carlo(
+        model, estimator, n_steps, n_runs,
+        x0_mean=ENGINE_X0_MEAN, x0_cov=ENGINE_X0_COV, x0_hat=ENGINE_X0_HAT, rng=ENGINE_SEED, u=u,
+    )
+    rec = mean_error_recursion(model, K, x0_mean=ENGINE_X0_MEAN, x0_hat=ENGINE_X0_HAT, u=u, B_f=B_f)
+    return mc, rec
+
+
+# --------------------------------------------------------------------------- « Prédicteur–correcteur »
+
+
+#: Facteurs appliqués à la covariance de mesure Ψ du filtre pour montrer les deux limites du gain.
+LIMIT_SCALES = (1e6, 1e-6)
+
+
+def gain_limit_run(scale: float, n_steps: int = 120):
+    r"""Moteur simulé avec le vrai :math:`\Psi`, filtré en supposant :math:`s\,\Psi` (``scale`` = :math:`s`).
+
+    Renvoie ``(simulation, FilterResult)``. :math:`s \to \infty` : :math:`K \to 0` ;
+    :math:`s \to 0` : :math:`K \to C^{-1}` (ici :math:`C` est inversible sans être l'identité).
+    """
+    u = engine_commands(n_steps)
+    sim = simulate(engine_model(), ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
+    result = kalman_filter(engine_model(Psi=scale * ENGINE_PSI), sim.y, ENGINE_X0_HAT, ENGINE_P0, u)
+    return sim, result
+
+
+def gain_limit_sweep(scales=None, n_steps: int = 120):
+    r"""Gain final :math:`K_T` en fonction du facteur :math:`s` : renvoie ``(scales, ‖K‖/‖C⁻¹‖, ‖K − C⁻¹‖/‖C⁻¹‖)``
+    (normes de Frobenius)."""
+    scales = np.logspace(-8, 8, 33) if scales is None else np.asarray(scales, dtype=float)
+    C_inv = scipy.linalg.inv(engine_model().C)
+    norm = np.linalg.norm(C_inv)
+    to_zero, to_inverse = [], []
+    for s in scales:
+        K = gain_limit_run(float(s), n_steps)[1].K[-1]
+        to_zero.append(np.linalg.norm(K) / norm)
+        to_inverse.append(np.linalg.norm(K - C_inv) / norm)
+    return scales, np.array(to_zero), np.array(to_inverse)
+
+
+# --------------------------------------------------------------------------- « Tests statistiques »
+
+#: Durée des relevés du banc d'essai des tests statistiques (pas d'une seconde).
+CONSISTENCY_STEPS = 500
+#: Monte-Carlo de la NEES : nombre de tirages, durée, graine.
+CONSISTENCY_MC_RUNS, CONSISTENCY_MC_STEPS, CONSISTENCY_MC_SEED = 100, 100, 2001
+
+
+def incomplete_engine_model() -> LinearGaussianModel:
+    r"""Le moteur sans couplage thermique : :math:`A = \operatorname{diag}(0{,}95 ; 0{,}96)` au lieu de
+    la matrice pleine du système (les termes 0,03 et 0,02 sont oubliés) ; le reste est juste."""
+    model = engine_model()
+    return LinearGaussianModel(np.diag(np.diag(model.A)), model.C, model.Q, model.R, B=model.B)
+
+
+def consistency_filters() -> dict[str, LinearGaussianModel]:
+    """Les quatre filtres du banc d'essai, par nom affiché : le modèle juste, Ψ dix fois trop petit, Φ dix
+    fois trop grand, le couplage oublié."""
+    return {
+        "modèle juste": engine_model(),
+        "Ψ ÷ 10": engine_model(Psi=ENGINE_PSI / 10),
+        "Φ × 10": engine_model(Phi=10 * ENGINE_PHI),
+        "couplage oublié": incomplete_engine_model(),
+    }
+
+
+def consistency_runs(n_steps: int = CONSISTENCY_STEPS) -> tuple[Simulation, dict[str, FilterResult]]:
+    """Le moteur simulé une fois (modèle vrai, graine du scénario), filtré par chacun des filtres de
+    :func:`consistency_filters` ; renvoie ``(simulation, {nom: FilterResult})``."""
+    true = engine_model()
+    u = engine_commands(n_steps)
+    sim = simulate(true, ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
+    results = {name: kalman_filter(m, sim.y, ENGINE_X0_HAT, ENGINE_P0, u) for name, m in consistency_filters().items()}
+    return sim, results
+
+
+def consistency_monte_carlo(n_runs: int = CONSISTENCY_MC_RUNS, n_steps: int = CONSISTENCY_MC_STEPS) -> dict[str, ConsistencyRuns]:
+    r"""NEES et NIS de ``n_runs`` tirages (``n_steps`` pas) pour le modèle juste et les deux réglages faux ;
+    initialisation cohérente :math:`x_0 \sim \mathcal N(\hat x_0, P_0)`."""
+    true = engine_model()
+    u = engine_commands(n_steps)
+    filters = consistency_filters()
+    return {
+        name: monte_carlo_consistency(true, n_steps, n_runs, x0_hat=ENGINE_X0_MEAN, P0=ENGINE_X0_COV,
+                                      rng=CONSISTENCY_MC_SEED, filter_model=filters[name], u=u)
+        for name in ("modèle juste", "Ψ ÷ 10", "Φ × 10")
+    }
