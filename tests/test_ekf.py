@@ -83,14 +83,8 @@ def _pendulum(dt=0.05, g_over_l=9.81, L=1.0):
 
 def _pendulum_data(n=200, seed=5):
     f, F, h, H = _pendulum()
-    rng = np.random.default_rng(seed)
-    x = np.array([1.2, 0.0])
-    xs, ys = [], []
-    for _ in range(n):
-        x = f(x) + rng.normal(scale=[1e-3, 1e-2])
-        xs.append(x)
-        ys.append(h(x) + rng.normal(scale=0.05, size=2))
-    return np.array(xs), np.array(ys)
+    sim = kc.simulate(kc.NonlinearModel(f, h, np.diag([1e-3, 1e-2]) ** 2, 0.05**2 * np.eye(2)), [1.2, 0.0], n, rng=seed)
+    return sim.x, sim.y
 
 
 def test_nonlinear_dynamics_ekf_equals_filterpy():

@@ -171,3 +171,31 @@ def test_errata_functions_reject_bad_model():
         table_literal_iterates(None, [0.0], [[1.0]], [0.0])
     p = radar.radar_update_problem()
     assert no_correction_iterates(p.model, p.x_pred, p.P_pred, p.y, max_iter=3).shape == (4, 2)
+
+
+# --------------------------------------------------------------------------- innovation et S cohérents
+
+
+def test_stored_innovation_and_S_come_from_the_last_linearisation():
+    """ν et S rangés par la correction itérée sont ceux de la dernière linéarisation (au point x^(N−1)),
+    recalculés ici à la main : la NIS νᵀS⁻¹ν est celle du filtre linéarisé en ce point, et x^(N) = x⁻ + Kν."""
+    p = radar.radar_update_problem()
+    out = kc.iekf_update(p.model, p.x_pred, p.P_pred, p.y)
+    x_last = out.iterates[-2]
+    H = radar.range_bearing_jacobian(x_last)
+    R = np.array(p.model.R)
+    r = p.y - radar.range_bearing(x_last)
+    r[1] = np.arctan2(np.sin(r[1]), np.cos(r[1]))
+    nu = r - H @ (p.x_pred - x_last)
+    S = H @ p.P_pred @ H.T + R
+    K = np.linalg.solve(S, H @ p.P_pred).T
+    np.testing.assert_allclose(out.innovation, nu, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(out.S, S, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(out.K, K, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(out.x, p.x_pred + K @ nu, rtol=1e-12, atol=1e-12)
+    # sur une poursuite : chaque pas vérifie x = x⁻ + Kν, et la NIS se calcule sur le résultat
+    x_true, y, x0, P0 = radar.radar_tracking_data()
+    res = kc.iterated_extended_kalman_filter(radar.radar_tracking_model(), y, x0, P0)
+    np.testing.assert_allclose(res.x, res.x_pred + np.einsum("kij,kj->ki", res.K, res.innovation), atol=1e-9)
+    nis = kc.nis(res)
+    assert np.isfinite(nis).all() and 1.0 < nis.mean() < 3.0  # χ²₂ : moyenne 2
