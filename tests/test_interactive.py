@@ -376,8 +376,8 @@ def test_bad_grid_and_figure_arguments():
     t = np.arange(3.0)
     with pytest.raises(kc.KalmanInputError, match="mêmes séries"):
         ki.precompute_grid(lambda u, v: {"s": t} if u == 1.0 else {"autre": t}, a, a, t)
-    with pytest.raises(kc.KalmanInputError, match=r"forme \(3,\)"):
-        ki.precompute_grid(lambda u, v: {"s": np.zeros(4)}, a, a, t)
+    with pytest.raises(kc.KalmanInputError, match=r"forme \(4,\)"):  # longueur changeante d'un appel à l'autre
+        ki.precompute_grid(lambda u, v: {"s": np.zeros(4 if u == 1.0 else 5)}, a, a, t)
     with pytest.raises(kc.KalmanInputError, match="ParameterAxis"):
         ki.precompute_grid(lambda u, v: {"s": t}, [1.0, 2.0], a, t)
     grid = ki.precompute_grid(lambda u, v: {"s": t * u}, a, a, t)
@@ -386,8 +386,9 @@ def test_bad_grid_and_figure_arguments():
         ki.StaticSliders(grid, (ki.Panel("p", "s (m)", (ki.Glyph("inconnue", "line", "red", "s"),)),), "t (s)")
     with pytest.raises(kc.KalmanInputError, match="identifiant court"):
         ki.StaticSliders(grid, (panel,), "t (s)", name="Mon Nom")
-    with pytest.raises(kc.KalmanInputError, match=r"forme \(3,\)"):
-        ki.StaticSliders(grid, (panel,), "t (s)", fixed={"z": np.zeros(5)})
+    with pytest.raises(kc.KalmanInputError, match="longueurs différentes"):  # tracée contre le temps commun
+        ki.StaticSliders(grid, (ki.Panel("p", "z (m)", (ki.Glyph("z", "line", "red", "z"),)),), "t (s)",
+                         fixed={"z": np.zeros(5)})
     with pytest.raises(kc.KalmanInputError, match="réservé"):
         ki.StaticSliders(grid, (panel,), "t (s)", fixed={"t": t})
     with pytest.raises(kc.KalmanInputError, match="min_exp"):

@@ -1,36 +1,74 @@
 """Interactivité du cours : curseurs statiques (livre publié, sans noyau) et vivants (Jupyter).
 
-- :func:`voltage_sliders` : figure Bokeh à deux curseurs (Φ, Ψ) sur des exécutions précalculées à la
-  construction du livre ; la page publiée ne fait que choisir parmi elles (aucun noyau, aucun serveur).
-- :func:`live_voltage_explorer` : curseurs ipywidgets (Φ, Ψ, P₀) qui relancent le filtre ; il faut un
-  noyau (Jupyter, Binder, Colab).
-- :func:`tag_sliders`, :func:`live_tag_explorer` : les mêmes pour l'EKF du tag UWB (σₐ, σᵣ).
-- :mod:`.grid` : les grilles précalculées (numpy seulement) ; :mod:`.sphinx_ext` : l'extension Sphinx
-  qui sert BokehJS aux pages qui en ont besoin.
+Chaque chapitre a au moins une figure à curseurs, décrite une fois (:class:`SliderSpec`, inscrite au
+registre par :func:`register_sliders`) et rendue de deux façons :
+
+- :func:`sliders` (``kc.interactive.sliders("nom")``) : figure Bokeh sur des exécutions précalculées à la
+  construction du livre ; la page publiée ne fait que choisir parmi elles (aucun noyau, aucun serveur) ;
+- :func:`live_explorer` (``kc.interactive.live_explorer("nom")``) : curseurs ipywidgets qui relancent le
+  calcul du paquet ; il faut un noyau (Jupyter, Binder, Colab).
+
+:func:`voltage_sliders`, :func:`live_voltage_explorer`, :func:`tag_sliders`, :func:`live_tag_explorer`
+restent disponibles sous leur nom. :mod:`.grid` : les grilles précalculées (numpy seulement) ;
+:mod:`.sphinx_ext` : l'extension Sphinx qui sert BokehJS aux pages qui en ont besoin ; :mod:`.quiz` :
+la directive ``quiz`` des questionnaires corrigés dans la page.
 
 Seul ce sous-paquet importe bokeh et ipywidgets.
 """
 
+from .figure import (
+    SLIDER_FIGURES,
+    SliderSpec,
+    live_explorer,
+    register_sliders,
+    slider_grid,
+    slider_names,
+    slider_spec,
+    sliders,
+)
 from .grid import ParameterAxis, ParameterGrid, format_value, log_grid, precompute_grid
-from .live import LiveExplorer, LogParameter
+from .live import ChoiceParameter, LinearParameter, LiveExplorer, LogParameter
 from .spec import Glyph, Panel
 from .static import StaticSliders
 from .tag import live_tag_explorer, tag_axes, tag_grid, tag_run, tag_sliders
 from .voltage import live_voltage_explorer, voltage_axes, voltage_grid, voltage_run, voltage_sliders
+# une figure à curseurs par chapitre (chaque module inscrit les siennes au registre)
+from . import intro  # noqa: F401  (introduction)
+from . import intuition  # noqa: F401  (« Le filtre de Kalman en images »)
+from . import system  # noqa: F401  (« Contrôle d'un système dynamique »)
+from . import estimator  # noqa: F401  (« Construction d'un estimateur »)
+from . import predictor  # noqa: F401  (« Le filtre prédicteur–correcteur »)
+from . import gain  # noqa: F401  (« Dynamique de l'erreur et gain optimal »)
+from . import practice  # noqa: F401  (« Implémentation pratique et synthèse »)
+from . import consistency  # noqa: F401  (« Vérifier les hypothèses : tests statistiques »)
+from . import ekf  # noqa: F401  (« Le filtre de Kalman étendu » et « Pour aller plus loin »)
+from . import iekf  # noqa: F401  (« Filtre de Kalman étendu itéré »)
+from . import srif  # noqa: F401  (« Filtre d'information en racine carrée »)
+from . import se3  # noqa: F401  (« EKF itéré sur SE(3) »)
 
 __all__ = [
+    "ChoiceParameter",
     "Glyph",
+    "LinearParameter",
     "LiveExplorer",
     "LogParameter",
     "Panel",
     "ParameterAxis",
     "ParameterGrid",
+    "SLIDER_FIGURES",
+    "SliderSpec",
     "StaticSliders",
     "format_value",
+    "live_explorer",
     "live_tag_explorer",
     "live_voltage_explorer",
     "log_grid",
     "precompute_grid",
+    "register_sliders",
+    "slider_grid",
+    "slider_names",
+    "slider_spec",
+    "sliders",
     "tag_axes",
     "tag_grid",
     "tag_run",

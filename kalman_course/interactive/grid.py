@@ -1,16 +1,18 @@
 r"""Grilles de paramètres précalculées pour les curseurs statiques (numpy seulement, aucun tracé).
 
 Une page HTML publiée n'a pas de noyau Python : pour qu'un curseur y change la figure, toutes les
-exécutions possibles sont calculées à la construction du livre, sur une grille logarithmique de deux
-paramètres (par exemple :math:`\Phi` et :math:`\Psi`), et la page ne fait que choisir la bonne.
+exécutions possibles sont calculées à la construction du livre, sur une grille d'un à trois
+paramètres (par exemple :math:`\Phi` et :math:`\Psi` sur une grille logarithmique, un gain sur une
+grille linéaire, un numéro d'itération), et la page ne fait que choisir la bonne.
 
 Ce module ne connaît aucun filtre : :func:`precompute_grid` appelle, pour chaque point de la grille,
-une fonction ``run(a, b)`` fournie par le chapitre (qui appelle le filtre du paquet) et empile ses
+une fonction ``run(a, b, …)`` fournie par le chapitre (qui appelle le filtre du paquet) et empile ses
 séries. Les séries sont gardées en ``float64`` : la page affiche exactement les valeurs du paquet.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Callable, Mapping
@@ -20,7 +22,7 @@ import numpy as np
 from ..core.results import freeze
 from ..core.validation import KalmanInputError, as_float_array, shape_text
 
-__all__ = ["ParameterAxis", "ParameterGrid", "log_grid", "precompute_grid", "format_value"]
+__all__ = ["AXIS_SCALES", "ParameterAxis", "ParameterGrid", "log_grid", "precompute_grid", "format_value"]
 
 _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 
@@ -47,13 +49,21 @@ def format_value(value: float, unit: str = "") -> str:
     return f"{text} {unit}".strip()
 
 
+#: Échelles possibles d'un axe : logarithmique (valeurs > 0, une variance), linéaire (un gain, un
+#: angle), ou suite de positions (un numéro d'itération, une étape de la boucle).
+AXIS_SCALES = ("log", "linear", "index")
+
+
 @dataclass(frozen=True, eq=False)
 class ParameterAxis:
     """Un axe de la grille : le paramètre que déplace un curseur.
 
     ``name`` : identifiant (``"Q"``) ; ``symbol`` : notation du cours (``"Φ"``) ; ``description`` :
-    libellé français du curseur ; ``unit`` : unité (``"V²"``) ; ``values`` : (N,) valeurs croissantes,
-    strictement positives ; ``default`` : indice de la valeur par défaut (celle de la figure statique).
+    libellé français du curseur ; ``unit`` : unité (``"V²"``) ; ``values`` : (N,) valeurs strictement
+    croissantes ; ``default`` : indice de la valeur par défaut (celle de la figure statique).
+    ``scale`` : ``"log"`` (valeurs strictement positives, grille logarithmique, par défaut),
+    ``"linear"`` ou ``"index"`` (positions discrètes : itération, étape). ``tick_labels`` : texte
+    affiché par le curseur à chaque position (par défaut, la valeur écrite en français avec l'unité).
     """
 
     name: str
@@ -62,6 +72,8 @@ class ParameterAxis:
     unit: str
     values: np.ndarray
     default: int
+    scale: str = "log"
+    tick_labels: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         values = as_float_array(f"valeurs de {self.name}", self.values)
@@ -70,16 +82,29 @@ class ParameterAxis:
                 f"Les valeurs de « {self.name} » doivent former un vecteur d'au moins 2 valeurs ; "
                 f"reçu {shape_text(values.shape)}."
             )
-        if not (values > 0).all() or not (np.diff(values) > 0).all():
+        if self.scale not in AXIS_SCALES:
+            raise KalmanInputError(
+                f"« scale » de « {self.name} » doit valoir {', '.join(map(repr, AXIS_SCALES))} ; reçu {self.scale!r}."
+            )
+        if self.scale == "log" and not (values > 0).all() or not (np.diff(values) > 0).all():
             raise KalmanInputError(
                 f"Les valeurs de « {self.name} » doivent être strictement positives et croissantes "
-                f"(grille logarithmique)."
+                f"(grille logarithmique)." if self.scale == "log" else
+                f"Les valeurs de « {self.name} » doivent être strictement croissantes."
             )
         if not (isinstance(self.default, (int, np.integer)) and 0 <= self.default < values.size):
             raise KalmanInputError(
                 f"L'indice par défaut de « {self.name} » doit être un entier entre 0 et {values.size - 1} ; "
                 f"reçu {self.default!r}."
             )
+        if self.tick_labels is not None:
+            labels = tuple(self.tick_labels)
+            if len(labels) != values.size or not all(isinstance(t, str) and t for t in labels):
+                raise KalmanInputError(
+                    f"« tick_labels » de « {self.name} » doit donner un texte non vide par valeur "
+                    f"({values.size} attendus) ; reçu {len(labels)}."
+                )
+            object.__setattr__(self, "tick_labels", labels)
         object.__setattr__(self, "values", freeze(values))
         object.__setattr__(self, "default", int(self.default))
 
@@ -90,6 +115,8 @@ class ParameterAxis:
 
     def labels(self) -> list[str]:
         """Les valeurs réelles, écrites en français avec l'unité (ce qu'affiche le curseur)."""
+        if self.tick_labels is not None:
+            return list(self.tick_labels)
         return [format_value(v, self.unit) for v in self.values]
 
     def index_of(self, value: float) -> int:
@@ -127,81 +154,130 @@ def log_grid(center: float, decades_below: int, decades_above: int, per_decade: 
 
 @dataclass(frozen=True, eq=False)
 class ParameterGrid:
-    """Exécutions précalculées sur la grille ``axes[0] × axes[1]``.
+    """Exécutions précalculées sur la grille ``axes[0] × … × axes[d-1]`` (un à trois curseurs).
 
-    ``series[nom]`` a la forme ``(N0, N1, T)`` : ``series[nom][i, j]`` est la série ``nom`` de
+    ``series[nom]`` a la forme ``(N0, …, N_{d-1}, L)`` : ``series[nom][i, j]`` est la série ``nom`` de
     l'exécution avec ``axes[0].values[i]`` et ``axes[1].values[j]``. ``time`` (T,) : abscisse commune
-    (numéro d'itération ou temps). Tableaux en lecture seule, ``float64``.
+    (numéro d'itération ou temps) des séries de longueur ``L = T`` ; une série peut avoir une autre
+    longueur (un point, un segment, une courbe sur une autre abscisse), la même à chaque exécution.
+    Tableaux en lecture seule, ``float64``.
     """
 
-    axes: tuple[ParameterAxis, ParameterAxis]
+    axes: tuple[ParameterAxis, ...]
     time: np.ndarray
     series: Mapping[str, np.ndarray]
 
     @property
-    def shape(self) -> tuple[int, int]:
-        """``(N0, N1)`` : nombre de positions de chaque curseur."""
-        return (self.axes[0].values.size, self.axes[1].values.size)
+    def shape(self) -> tuple[int, ...]:
+        """``(N0, N1, …)`` : nombre de positions de chaque curseur."""
+        return tuple(axis.values.size for axis in self.axes)
 
     @property
-    def default_index(self) -> tuple[int, int]:
-        """Position par défaut des deux curseurs."""
-        return (self.axes[0].default, self.axes[1].default)
+    def size(self) -> int:
+        """Nombre d'exécutions de la grille."""
+        return int(np.prod(self.shape))
 
-    def run(self, i: int, j: int) -> dict[str, np.ndarray]:
-        """Les séries de l'exécution ``(i, j)`` (chacune de forme (T,))."""
-        n0, n1 = self.shape
-        if not (0 <= i < n0 and 0 <= j < n1):
-            raise KalmanInputError(f"Point de grille ({i}, {j}) hors de la grille {n0} × {n1}.")
-        return {name: values[i, j] for name, values in self.series.items()}
+    @property
+    def default_index(self) -> tuple[int, ...]:
+        """Position par défaut des curseurs."""
+        return tuple(axis.default for axis in self.axes)
+
+    def length(self, name: str) -> int:
+        """Longueur ``L`` de la série ``name`` (nombre de points d'une exécution)."""
+        return int(self.series[name].shape[-1])
+
+    def values_at(self, *index: int) -> tuple[float, ...]:
+        """Les valeurs des paramètres au point de grille ``index``."""
+        self._check(index)
+        return tuple(float(axis.values[i]) for axis, i in zip(self.axes, index))
+
+    def _check(self, index) -> None:
+        shape = self.shape
+        if len(index) != len(shape) or not all(
+            isinstance(i, (int, np.integer)) and 0 <= i < n for i, n in zip(index, shape)
+        ):
+            raise KalmanInputError(
+                f"Point de grille {tuple(index)} hors de la grille {' × '.join(map(str, shape))}."
+            )
+
+    def run(self, *index: int) -> dict[str, np.ndarray]:
+        """Les séries de l'exécution ``index`` (une par curseur)."""
+        self._check(index)
+        return {name: values[tuple(index)] for name, values in self.series.items()}
 
     def flat(self, name: str) -> np.ndarray:
-        """La série ``name`` aplatie en ``(N0·N1·T,)`` (ordre C : l'exécution ``(i, j)`` commence à
-        ``(i·N1 + j)·T``) : c'est la forme envoyée au navigateur."""
+        """La série ``name`` aplatie en ``(N0·N1·…·L,)`` (ordre C : l'exécution ``(i, j)`` commence à
+        ``(i·N1 + j)·L``) : c'est la forme envoyée au navigateur."""
         return np.ascontiguousarray(self.series[name]).reshape(-1)
 
 
-def precompute_grid(
-    run: Callable[[float, float], Mapping[str, np.ndarray]],
-    first: ParameterAxis,
-    second: ParameterAxis,
-    time: np.ndarray,
-) -> ParameterGrid:
-    """Appelle ``run(a, b)`` pour chaque couple ``(a, b)`` de ``first.values × second.values``.
+def _split_time(axes: tuple, time) -> tuple[tuple, object]:
+    """Ancienne forme ``precompute_grid(run, a, b, time)`` : le dernier argument positionnel est le temps."""
+    if time is None and axes and not isinstance(axes[-1], ParameterAxis):
+        return axes[:-1], axes[-1]
+    return axes, time
 
-    ``run`` renvoie un dictionnaire de séries 1-D de même longueur ``T = len(time)`` (les mêmes
-    noms à chaque appel). Renvoie la :class:`ParameterGrid` de ces séries, de forme ``(N0, N1, T)``.
+
+def precompute_grid(
+    run: Callable[..., Mapping[str, np.ndarray]],
+    *axes: ParameterAxis,
+    time: np.ndarray | None = None,
+) -> ParameterGrid:
+    """Appelle ``run(a, b, …)`` pour chaque point ``(a, b, …)`` de ``axes[0].values × axes[1].values × …``.
+
+    ``run`` renvoie un dictionnaire de séries 1-D (les mêmes noms et les mêmes longueurs à chaque
+    appel). ``time`` (T,) : abscisse commune des séries de longueur T. Renvoie la
+    :class:`ParameterGrid` de ces séries, de forme ``(N0, …, L)``.
     """
+    axes, time = _split_time(axes, time)
     if not callable(run):
-        raise KalmanInputError(f"« run » doit être une fonction run(a, b) ; reçu {type(run).__name__}.")
-    for label, axis in (("first", first), ("second", second)):
+        raise KalmanInputError(f"« run » doit être une fonction run(a, b, …) ; reçu {type(run).__name__}.")
+    if not 1 <= len(axes) <= 3:
+        raise KalmanInputError(f"Une grille a un, deux ou trois axes (curseurs) ; reçu {len(axes)}.")
+    for k, axis in enumerate(axes):
         if not isinstance(axis, ParameterAxis):
-            raise KalmanInputError(f"« {label} » doit être un ParameterAxis ; reçu {type(axis).__name__}.")
+            raise KalmanInputError(f"L'axe n° {k + 1} doit être un ParameterAxis ; reçu {type(axis).__name__}.")
+    if time is None:
+        raise KalmanInputError("Donnez « time », l'abscisse commune des séries (vecteur non vide).")
     t = as_float_array("time", time)
     if t.ndim != 1 or t.size == 0:
         raise KalmanInputError(f"« time » doit être un vecteur non vide ; reçu {shape_text(t.shape)}.")
-    n0, n1, T = first.values.size, second.values.size, t.size
+    shape = tuple(axis.values.size for axis in axes)
     series: dict[str, np.ndarray] = {}
-    for i, a in enumerate(first.values):
-        for j, b in enumerate(second.values):
-            out = run(float(a), float(b))
-            if i == 0 and j == 0:
-                if not out:
-                    raise KalmanInputError("« run » doit renvoyer au moins une série (dictionnaire non vide).")
-                series = {name: np.empty((n0, n1, T)) for name in out}
-            if set(out) != set(series):
-                raise KalmanInputError(
-                    f"« run » doit renvoyer les mêmes séries à chaque appel : {sorted(series)} attendu, "
-                    f"{sorted(out)} reçu pour ({a:g}, {b:g})."
-                )
+    for index in itertools.product(*(range(n) for n in shape)):
+        point = tuple(float(axis.values[i]) for axis, i in zip(axes, index))
+        out = run(*point)
+        if not series:
+            if not out:
+                raise KalmanInputError("« run » doit renvoyer au moins une série (dictionnaire non vide).")
             for name, values in out.items():
                 arr = np.asarray(values, dtype=float)
-                if arr.shape != (T,):
+                if arr.ndim != 1 or arr.size == 0:
                     raise KalmanInputError(
-                        f"La série « {name} » doit avoir la forme ({T},) (une valeur par instant) ; "
-                        f"reçu {arr.shape}."
+                        f"La série « {name} » doit être un vecteur non vide (une valeur par point) ; "
+                        f"reçu la forme {arr.shape}."
                     )
-                series[name][i, j] = arr
-    return ParameterGrid(
-        axes=(first, second), time=freeze(t), series={k: freeze(v) for k, v in series.items()}
-    )
+                series[name] = np.empty(shape + (arr.size,))
+        if set(out) != set(series):
+            raise KalmanInputError(
+                f"« run » doit renvoyer les mêmes séries à chaque appel : {sorted(series)} attendu, "
+                f"{sorted(out)} reçu pour {_point_text(point)}."
+            )
+        for name, values in out.items():
+            arr = np.asarray(values, dtype=float)
+            expected = (series[name].shape[-1],)
+            if arr.shape != expected:
+                raise KalmanInputError(
+                    f"La série « {name} » doit avoir la forme {_shape(expected)} à chaque exécution ; "
+                    f"reçu {_shape(arr.shape)} pour {_point_text(point)}."
+                )
+            series[name][index] = arr
+    return ParameterGrid(axes=tuple(axes), time=freeze(t), series={k: freeze(v) for k, v in series.items()})
+
+
+def _shape(shape: tuple) -> str:
+    return "(" + ", ".join(map(str, shape)) + ("," if len(shape) == 1 else "") + ")"
+
+
+def _point_text(point: tuple[float, ...]) -> str:
+    return "(" + " ; ".join(format_value(v) for v in point) + ")"

@@ -23,10 +23,14 @@ from ..figures import new_figure
 from ..core.validation import KalmanInputError, as_float_array
 from .spec import Panel, check_columns
 
-__all__ = ["LogParameter", "LiveExplorer"]
+__all__ = ["LogParameter", "LinearParameter", "ChoiceParameter", "LiveExplorer"]
 
 #: Résolution du PNG affiché (pixels par pouce).
 LIVE_DPI = 100
+#: Styles de trait et marqueurs matplotlib des tracés décrits par :class:`~.spec.Glyph`.
+_MPL_DASH = {"solid": "-", "dashed": "--", "dotted": ":", "dashdot": "-."}
+_MPL_MARKER = {"cross": "+", "circle": "o", "square": "s", "diamond": "D", "triangle": "^", "x": "x",
+               "star": "*", "dot": "."}
 
 
 @dataclass(frozen=True)
@@ -71,6 +75,76 @@ class LogParameter:
         )
 
 
+@dataclass(frozen=True)
+class LinearParameter:
+    """Un curseur linéaire (``FloatSlider``) : ``name``, ``description``, ``unit``, valeur initiale
+    ``value``, bornes ``low`` et ``high``, pas ``step``."""
+
+    name: str
+    description: str
+    unit: str
+    value: float
+    low: float
+    high: float
+    step: float
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
+            raise KalmanInputError(
+                f"Curseur « {self.name} » : « low » ({self.low}) doit être < « high » ({self.high})."
+            )
+        if not (isinstance(self.step, (int, float)) and self.step > 0):
+            raise KalmanInputError(f"Curseur « {self.name} » : « step » doit être > 0 ; reçu {self.step!r}.")
+        v = float(self.value)
+        if not (math.isfinite(v) and self.low <= v <= self.high):
+            raise KalmanInputError(
+                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{self.low:g} ; {self.high:g}] {self.unit}."
+            )
+
+    def slider(self) -> widgets.FloatSlider:
+        """Le ``FloatSlider`` (la valeur lue est la vraie valeur)."""
+        return widgets.FloatSlider(
+            value=float(self.value), min=self.low, max=self.high, step=self.step,
+            description=f"{self.description} ({self.unit})" if self.unit else self.description,
+            readout_format=".3g", continuous_update=False,
+            style={"description_width": "14em"}, layout=widgets.Layout(width="36em"),
+        )
+
+
+@dataclass(frozen=True)
+class ChoiceParameter:
+    """Un curseur à positions discrètes (``SelectionSlider``) : une itération, une étape de la boucle.
+
+    ``values`` : les valeurs passées à ``run`` ; ``labels`` : le texte affiché à chaque position ;
+    ``value`` : la valeur initiale (une des ``values``)."""
+
+    name: str
+    description: str
+    values: tuple[float, ...]
+    labels: tuple[str, ...]
+    value: float
+
+    def __post_init__(self) -> None:
+        if len(self.values) < 2 or len(self.values) != len(self.labels):
+            raise KalmanInputError(
+                f"Curseur « {self.name} » : au moins deux valeurs, et un libellé par valeur "
+                f"({len(self.values)} valeurs, {len(self.labels)} libellés)."
+            )
+        if float(self.value) not in [float(v) for v in self.values]:
+            raise KalmanInputError(f"« {self.name} » = {self.value!r} n'est pas une des positions du curseur.")
+
+    def slider(self) -> widgets.SelectionSlider:
+        """Le ``SelectionSlider`` : affiche le libellé, renvoie la valeur."""
+        return widgets.SelectionSlider(
+            options=list(zip(self.labels, [float(v) for v in self.values])), value=float(self.value),
+            description=self.description, continuous_update=False,
+            style={"description_width": "14em"}, layout=widgets.Layout(width="36em"),
+        )
+
+
+_PARAMETERS = (LogParameter, LinearParameter, ChoiceParameter)
+
+
 class LiveExplorer:
     """Curseurs ipywidgets + figure matplotlib redessinée par le filtre du paquet.
 
@@ -78,7 +152,7 @@ class LiveExplorer:
     ----------
     run : fonction ``run(**valeurs) -> dict nom → (T,)``
         Relance le filtre pour les valeurs des curseurs (une clé par ``LogParameter.name``).
-    parameters : suite de LogParameter
+    parameters : suite de LogParameter, LinearParameter ou ChoiceParameter
         Les curseurs, dans l'ordre d'affichage.
     time : (T,)
         Abscisse commune.
@@ -86,8 +160,10 @@ class LiveExplorer:
         La figure (la même description que pour les curseurs statiques).
     x_label : str
         Libellé de l'abscisse, avec unité.
-    fixed : dict nom → (T,), optionnel
-        Séries indépendantes des curseurs (mesures).
+    fixed : dict nom → (L,), optionnel
+        Séries indépendantes des curseurs (mesures, courbe de référence).
+    readout : fonction ``(séries, valeurs) -> str``, optionnelle
+        Texte affiché au-dessus de la figure (les nombres de l'exécution courante).
 
     Attributs utiles : ``sliders`` (dict nom → ``FloatLogSlider``), ``series`` (la dernière
     exécution), ``lines`` (dict nom de série → liste de ``Line2D`` tracées), ``figure``, ``widget``.
@@ -101,12 +177,15 @@ class LiveExplorer:
         panels,
         x_label: str,
         fixed: Mapping[str, np.ndarray] | None = None,
+        readout: Callable[[Mapping[str, np.ndarray], Mapping[str, float]], str] | None = None,
     ) -> None:
         if not callable(run):
             raise KalmanInputError(f"« run » doit être une fonction ; reçu {type(run).__name__}.")
         self.parameters = tuple(parameters)
-        if not self.parameters or not all(isinstance(p, LogParameter) for p in self.parameters):
-            raise KalmanInputError("« parameters » doit être une suite non vide de LogParameter.")
+        if not self.parameters or not all(isinstance(p, _PARAMETERS) for p in self.parameters):
+            raise KalmanInputError(
+                "« parameters » doit être une suite non vide de LogParameter, LinearParameter ou ChoiceParameter."
+            )
         self.panels = tuple(panels)
         if not self.panels or not all(isinstance(p, Panel) for p in self.panels):
             raise KalmanInputError("« panels » doit être une suite non vide de Panel.")
@@ -115,12 +194,17 @@ class LiveExplorer:
         self.fixed = {k: as_float_array(f"fixed[{k!r}]", v, allow_nan=True) for k, v in (fixed or {}).items()}
         self.sliders = {p.name: p.slider() for p in self.parameters}
         self.series = self._compute()
-        check_columns(self.panels, set(self.series) | set(self.fixed))
+        self._lengths = {"t": self.time.size, **{k: v.size for k, v in self.fixed.items()},
+                         **{k: v.size for k, v in self.series.items()}}
+        check_columns(self.panels, set(self.series) | set(self.fixed), self._lengths)
+        self._fills: list = []
         self.figure, self.lines, self._axes = self._draw(x_label)
         self.image = widgets.Image(format="png", value=self._png())
+        self.readout = readout
+        self.text = widgets.HTML(value=self._text())
         for slider in self.sliders.values():
             slider.observe(self._on_change, names="value")
-        self.widget = widgets.VBox([*self.sliders.values(), self.image])
+        self.widget = widgets.VBox([*self.sliders.values(), self.text, self.image])
 
     # ------------------------------------------------------------------ calcul et dessin
 
@@ -132,12 +216,16 @@ class LiveExplorer:
         out = self.run(**self.values())
         T = self.time.size
         series = {}
+        known = getattr(self, "_lengths", None)
         for name, values in out.items():
             if name == "t":
                 raise KalmanInputError("« run » ne doit pas renvoyer de série nommée « t » (réservé au temps).")
             arr = np.asarray(values, dtype=float)
-            if arr.shape != (T,):
-                raise KalmanInputError(f"La série « {name} » doit avoir la forme ({T},) ; reçu {arr.shape}.")
+            expected = known[name] if known and name in known else None
+            if arr.ndim != 1 or (expected is not None and arr.size != expected):
+                raise KalmanInputError(
+                    f"La série « {name} » doit avoir la forme ({expected or T},) ; reçu {arr.shape}."
+                )
             series[name] = arr
         return series
 
@@ -151,16 +239,27 @@ class LiveExplorer:
         for ax, panel in zip(axes, self.panels):
             for glyph in panel.glyphs:
                 x = glyph.x
-                if glyph.kind == "hline":
-                    ax.axhline(glyph.value, color=glyph.color, lw=1.5, label=glyph.legend)
+                label = glyph.legend or None
+                if glyph.kind in ("hline", "vline"):
+                    draw = ax.axhline if glyph.kind == "hline" else ax.axvline
+                    draw(glyph.value, color=glyph.color, lw=1.5, ls=_MPL_DASH[glyph.dash], label=label)
                     continue
-                style = {"marker": "+", "ls": "none", "ms": 7} if glyph.kind == "scatter" else {"lw": 1.8}
-                (line,) = ax.plot(data[x], data[glyph.column], color=glyph.color, label=glyph.legend, **style)
+                if glyph.kind in ("area", "band"):
+                    self._fills.append((ax, glyph, self._fill(ax, glyph, data, label)))
+                    continue
+                if glyph.kind == "scatter":
+                    style = {"marker": _MPL_MARKER[glyph.marker], "ls": "none", "ms": glyph.size * 0.9}
+                else:
+                    style = {"lw": glyph.width * 0.9, "ls": _MPL_DASH[glyph.dash]}
+                (line,) = ax.plot(data[x], data[glyph.column], color=glyph.color, label=label, alpha=glyph.alpha,
+                                  **style)
                 line.kc_columns = (x, glyph.column)  # séries (abscisse, ordonnée) à relire au redessin
                 if glyph.column in self.series or x in self.series:
                     lines.setdefault(glyph.column, []).append(line)
             if panel.y_log:
                 ax.set_yscale("log")
+            if panel.x_log:
+                ax.set_xscale("log")
             if panel.y_range is not None:
                 ax.set_ylim(*panel.y_range)
             if panel.x_range is not None:
@@ -171,8 +270,19 @@ class LiveExplorer:
             ax.set_ylabel(panel.y_label)
             ax.set_xlabel(panel.x_label or x_label)
             ax.grid(alpha=0.3, which="both" if panel.y_log else "major")
-            ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
+            if any(g.legend for g in panel.glyphs):
+                ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
         return fig, lines, axes
+
+    @staticmethod
+    def _fill(ax, glyph, data, label=None):
+        lower = np.zeros_like(data[glyph.column]) if glyph.kind == "area" else data[glyph.column]
+        upper = data[glyph.column] if glyph.kind == "area" else data[glyph.upper]
+        return ax.fill_between(data[glyph.x], lower, upper, color=glyph.color, alpha=0.25 * glyph.alpha,
+                               lw=0, label=label)
+
+    def _text(self) -> str:
+        return "" if self.readout is None else str(self.readout(self.series, self.values()))
 
     def _png(self) -> bytes:
         buffer = io.BytesIO()
@@ -187,11 +297,17 @@ class LiveExplorer:
             for line in lines:
                 x, y = line.kc_columns
                 line.set_data(data[x], data[y])
+        fills = []
+        for ax, glyph, collection in self._fills:
+            collection.remove()
+            fills.append((ax, glyph, self._fill(ax, glyph, data)))
+        self._fills = fills
         for ax, panel in zip(self._axes, self.panels):
             if panel.y_range is None:
                 ax.relim()
                 ax.autoscale_view(scalex=False)
         self.image.value = self._png()
+        self.text.value = self._text()
 
     def _on_change(self, change) -> None:
         self.redraw()

@@ -4,10 +4,20 @@ vivants (matplotlib + ipywidgets) : un chapitre décrit sa figure une fois, les 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Mapping
 
 from ..core.validation import KalmanInputError
 
-__all__ = ["Glyph", "Panel"]
+__all__ = ["DASHES", "GLYPH_KINDS", "MARKERS", "Glyph", "Panel"]
+
+
+#: Sortes de tracés.
+GLYPH_KINDS = ("line", "scatter", "hline", "vline", "area", "band")
+#: Styles de trait.
+DASHES = ("solid", "dashed", "dotted", "dashdot")
+#: Marqueurs des nuages de points.
+MARKERS = ("cross", "circle", "square", "diamond", "triangle", "x", "star", "dot")
+_KINDS_TEXT = ", ".join(f'"{k}"' for k in GLYPH_KINDS)
 
 
 @dataclass(frozen=True)
@@ -15,10 +25,12 @@ class Glyph:
     """Un tracé d'un panneau.
 
     ``column`` : nom d'une série calculée (grille ou exécution) ou d'une série fixe, en ordonnée ;
-    ``kind`` : ``"line"``, ``"scatter"`` (croix) ou ``"hline"`` (droite horizontale d'ordonnée
-    ``value``, ``column`` ignoré) ; ``color`` : nom de couleur CSS ; ``legend`` : légende en français ;
+    ``kind`` : ``"line"``, ``"scatter"`` (marqueurs), ``"hline"`` (droite horizontale d'ordonnée
+    ``value``, ``column`` ignoré), ``"vline"`` (droite verticale d'abscisse ``value``), ``"area"``
+    (surface entre 0 et la série) ou ``"band"`` (surface entre ``column`` et la série ``upper``) ;
+    ``color`` : nom de couleur CSS ; ``legend`` : légende en français (vide : pas de légende) ;
     ``x`` : série en abscisse (``"t"``, le temps commun, par défaut ; par exemple la coordonnée x d'une
-    trajectoire).
+    trajectoire) ; ``dash``, ``width``, ``alpha``, ``marker``, ``size`` : style du trait ou des marqueurs.
     """
 
     column: str
@@ -27,14 +39,33 @@ class Glyph:
     legend: str
     value: float | None = None
     x: str = "t"
+    upper: str | None = None
+    dash: str = "solid"
+    width: float = 2.0
+    alpha: float = 1.0
+    marker: str = "cross"
+    size: float = 8.0
 
     def __post_init__(self) -> None:
-        if self.kind not in ("line", "scatter", "hline"):
+        if self.kind not in GLYPH_KINDS:
             raise KalmanInputError(
-                f"« kind » doit valoir \"line\", \"scatter\" ou \"hline\" ; reçu {self.kind!r}."
+                f"« kind » doit valoir {_KINDS_TEXT} ; reçu {self.kind!r}."
             )
-        if self.kind == "hline" and self.value is None:
-            raise KalmanInputError("Un tracé « hline » exige « value » (l'ordonnée de la droite).")
+        if self.kind in ("hline", "vline") and self.value is None:
+            raise KalmanInputError(f"Un tracé « {self.kind} » exige « value » (la position de la droite).")
+        if self.kind == "band" and not self.upper:
+            raise KalmanInputError("Un tracé « band » exige « upper » (la série du bord supérieur).")
+        if self.dash not in DASHES:
+            raise KalmanInputError(f"« dash » doit valoir {', '.join(DASHES)} ; reçu {self.dash!r}.")
+        if self.marker not in MARKERS:
+            raise KalmanInputError(f"« marker » doit valoir {', '.join(MARKERS)} ; reçu {self.marker!r}.")
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """Les séries lues par le tracé (abscisse comprise) ; aucune pour une droite."""
+        if self.kind in ("hline", "vline"):
+            return ()
+        return tuple(c for c in (self.x, self.column, self.upper) if c is not None)
 
 
 @dataclass(frozen=True)
@@ -45,7 +76,8 @@ class Panel:
     Par défaut l'abscisse est le temps commun de la figure (axe partagé par les panneaux). Un panneau
     dont les tracés ont une autre abscisse (``Glyph.x``, par exemple une trajectoire) donne son
     libellé ``x_label`` (avec unité), ses bornes ``x_range`` et, si ``equal_aspect``, la même échelle
-    sur les deux axes (plan d'une pièce).
+    sur les deux axes (plan d'une pièce) ; ``x_log`` : abscisse logarithmique ; ``width`` : largeur
+    fixe en pixels d'un panneau ``equal_aspect`` (sa hauteur s'en déduit), au lieu de toute la largeur.
     """
 
     title: str
@@ -57,6 +89,8 @@ class Panel:
     x_label: str | None = None
     x_range: tuple[float, float] | None = None
     equal_aspect: bool = False
+    x_log: bool = False
+    width: int | None = None
 
     def __post_init__(self) -> None:
         if not self.glyphs or not all(isinstance(g, Glyph) for g in self.glyphs):
@@ -76,17 +110,30 @@ class Panel:
         return any(g.x != "t" for g in self.glyphs) or self.x_range is not None
 
 
-def check_columns(panels, known: set[str]) -> None:
-    """Chaque tracé doit lire une série connue (calculée ou fixe)."""
+def check_columns(panels, known: set[str], lengths: Mapping[str, int] | None = None) -> None:
+    """Chaque tracé doit lire une série connue (calculée ou fixe) ; avec ``lengths`` (nom → longueur,
+    ``"t"`` compris), les séries d'un même tracé doivent avoir la même longueur."""
     for panel in panels:
         for glyph in panel.glyphs:
-            if glyph.kind != "hline" and glyph.x != "t" and glyph.x not in known:
+            if glyph.kind == "band" and glyph.upper not in known:
+                raise KalmanInputError(
+                    f"Le tracé « {glyph.legend} » prend pour bord supérieur « {glyph.upper} », série absente "
+                    f"({', '.join(sorted(known))})."
+                )
+            if glyph.columns and glyph.x != "t" and glyph.x not in known:
                 raise KalmanInputError(
                     f"Le tracé « {glyph.legend} » prend pour abscisse « {glyph.x} », série absente "
                     f"({', '.join(sorted(known))})."
                 )
-            if glyph.kind != "hline" and glyph.column not in known:
+            if glyph.columns and glyph.column not in known:
                 raise KalmanInputError(
                     f"Le tracé « {glyph.legend} » lit la série « {glyph.column} », absente des séries "
                     f"calculées et fixes ({', '.join(sorted(known))})."
                 )
+            if lengths is not None and glyph.columns:
+                sizes = {c: lengths[c] for c in glyph.columns}
+                if len(set(sizes.values())) > 1:
+                    detail = ", ".join(f"« {c} » : {n}" for c, n in sizes.items())
+                    raise KalmanInputError(
+                        f"Le tracé « {glyph.legend} » mêle des séries de longueurs différentes ({detail})."
+                    )

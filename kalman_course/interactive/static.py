@@ -1,4 +1,4 @@
-r"""Curseurs statiques : une figure Bokeh dont deux curseurs choisissent parmi des exécutions précalculées.
+r"""Curseurs statiques : une figure Bokeh dont des curseurs (un à trois) choisissent parmi des exécutions précalculées.
 
 La page publiée n'a pas de noyau : la figure embarque toute une :class:`~.grid.ParameterGrid`
 (``float64``, donc les valeurs exactes du paquet) et un petit rappel JavaScript (``CustomJS``) qui,
@@ -17,10 +17,11 @@ from __future__ import annotations
 
 import hashlib
 import html
+import itertools
 import json
 import re
 from dataclasses import dataclass, field
-from typing import Mapping
+from typing import Callable, Mapping
 
 import bokeh
 import numpy as np
@@ -39,10 +40,11 @@ from bokeh.models import (
 from bokeh.plotting import figure
 
 from ..core.validation import KalmanInputError, as_float_array
+from ..numbers import bokeh_tick_formatter
 from .grid import ParameterGrid
 from .spec import Panel, check_columns
 
-__all__ = ["MARKER", "BOKEH_VERSION", "PLOTTED_SOURCE", "bokehjs_files", "StaticSliders"]
+__all__ = ["MARKER", "BOKEH_VERSION", "PLOTTED_SOURCE", "bokehjs_files", "plotted_source_name", "StaticSliders"]
 
 #: Attribut HTML qui signale une figure à curseurs statiques (lu par l'extension Sphinx).
 MARKER = "data-kc-bokeh"
@@ -58,21 +60,32 @@ def bokehjs_files() -> list[str]:
     return [f"bokeh/bokeh-{BOKEH_VERSION}.min.js", f"bokeh/bokeh-widgets-{BOKEH_VERSION}.min.js"]
 
 
-# Rappel exécuté par le navigateur à chaque mouvement d'un curseur : l'exécution (i, j) occupe
-# les indices [(i·N1 + j)·T, (i·N1 + j + 1)·T) des séries aplaties de « grid ».
+# Rappel exécuté par le navigateur à chaque mouvement d'un curseur : l'exécution d'indice plat
+# k = (i·N1 + j)·N2 + … occupe, pour une série de longueur L, les indices [k·L, (k + 1)·L) de sa
+# version aplatie ; les séries sont groupées par longueur (une source tracée par longueur).
 _CALLBACK = """
-const i = Math.round(s0.value), j = Math.round(s1.value);
-const start = (i * n1 + j) * n_time;
-const data = {};
-for (const name of Object.keys(source.data)) data[name] = source.data[name];
-for (const name of names) data[name] = grid.data[name].slice(start, start + n_time);
-source.data = data;
+let k = 0;
+for (let a = 0; a < sliders.length; a++) k = k * dims[a] + Math.round(sliders[a].value);
+for (let g = 0; g < sources.length; g++) {
+  const source = sources[g], grid = grids[g], n = lengths[g];
+  const data = {};
+  for (const name of Object.keys(source.data)) data[name] = source.data[name];
+  for (const name of names[g]) data[name] = grid.data[name].slice(k * n, (k + 1) * n);
+  source.data = data;
+}
+if (readout !== null) readout.text = texts[k];
 """
+
+
+def plotted_source_name(length: int, time_length: int) -> str:
+    """Nom de la source tracée des séries de longueur ``length`` : :data:`PLOTTED_SOURCE` pour celles
+    du temps commun, ``kc-plotted-<longueur>`` pour les autres."""
+    return PLOTTED_SOURCE if length == time_length else f"{PLOTTED_SOURCE}-{length}"
 
 
 @dataclass(eq=False)
 class StaticSliders:
-    """Figure Bokeh à deux curseurs sur une grille précalculée (aucun noyau nécessaire).
+    """Figure Bokeh à curseurs (un à trois) sur une grille précalculée (aucun noyau nécessaire).
 
     Paramètres
     ----------
@@ -83,14 +96,17 @@ class StaticSliders:
         pour un panneau dont les tracés ont leur propre abscisse (``Glyph.x``).
     x_label : str
         Libellé de l'abscisse, avec unité.
-    fixed : dict nom → (T,), optionnel
-        Séries qui ne dépendent pas des curseurs (mesures, vérité).
+    fixed : dict nom → (L,), optionnel
+        Séries qui ne dépendent pas des curseurs (mesures, vérité, courbe de référence).
     name : str
         Identifiant court de la figure (attribut HTML, identifiant d'élément).
     title : str
         Titre affiché au-dessus des curseurs.
     live_hint : str
         L'appel qui donne les curseurs vivants équivalents dans Jupyter (cité hors du livre).
+    readout : fonction ``index -> str``, optionnelle
+        Le texte affiché sous les curseurs au point de grille ``index`` (tuple d'indices) : les
+        nombres de cette exécution, écrits en français (:func:`kalman_course.numbers.format_number`).
     """
 
     grid: ParameterGrid
@@ -100,6 +116,7 @@ class StaticSliders:
     name: str = "curseurs"
     title: str = ""
     live_hint: str = ""
+    readout: Callable[[tuple[int, ...]], str] | None = None
 
     def __post_init__(self) -> None:
         if not (isinstance(self.name, str) and re.fullmatch(r"[a-z0-9][a-z0-9-]*", self.name)):
@@ -117,16 +134,30 @@ class StaticSliders:
         fixed = {}
         for key, values in self.fixed.items():
             arr = as_float_array(f"fixed[{key!r}]", values, allow_nan=True)
-            if arr.shape != (T,):
-                raise KalmanInputError(f"La série fixe « {key} » doit avoir la forme ({T},) ; reçu {arr.shape}.")
+            if arr.ndim != 1 or arr.size == 0:
+                raise KalmanInputError(f"La série fixe « {key} » doit être un vecteur non vide ; reçu {arr.shape}.")
+            if key in self.grid.series:
+                raise KalmanInputError(f"La série fixe « {key} » porte le nom d'une série calculée.")
             fixed[key] = arr
         self.fixed = fixed
-        check_columns(self.panels, set(self.grid.series) | set(fixed))
+        lengths = {"t": T, **{k: v.size for k, v in fixed.items()}}
+        lengths.update({k: self.grid.length(k) for k in self.grid.series})
+        check_columns(self.panels, set(self.grid.series) | set(fixed), lengths)
+        for panel in self.panels:
+            for glyph in panel.glyphs:
+                if glyph.x == "t" and glyph.columns and lengths[glyph.column] != T:
+                    raise KalmanInputError(
+                        f"Le tracé « {glyph.legend} » a pour abscisse le temps commun : la série « {glyph.column} » "
+                        f"doit avoir la forme ({T},) ; reçu ({lengths[glyph.column]},)."
+                    )
+        if self.readout is not None and not callable(self.readout):
+            raise KalmanInputError("« readout » doit être une fonction index → texte.")
+        self._lengths = lengths
         self.layout = self._build()
 
     # ------------------------------------------------------------------ construction Bokeh
 
-    def _sliders(self) -> tuple[Slider, Slider]:
+    def _sliders(self) -> list[Slider]:
         sliders = []
         for k, axis in enumerate(self.grid.axes):
             labels = axis.labels()
@@ -143,7 +174,12 @@ class StaticSliders:
                     name=f"kc-slider-{k}",
                 )
             )
-        return sliders[0], sliders[1]
+        return sliders
+
+    def _column_values(self, name: str) -> np.ndarray:
+        if name in self.grid.series:
+            return self.grid.series[name].ravel()
+        return self.fixed[name]
 
     def _y_range(self, panel: Panel) -> tuple[float, float]:
         """Bornes fixes de l'ordonnée, communes à toute la grille : en déplaçant un curseur, on voit
@@ -154,29 +190,55 @@ class StaticSliders:
         for glyph in panel.glyphs:
             if glyph.kind == "hline":
                 values.append(np.array([glyph.value], dtype=float))
-            elif glyph.column in self.grid.series:
-                values.append(self.grid.series[glyph.column].ravel())
+            elif glyph.kind == "vline":
+                continue
             else:
-                values.append(self.fixed[glyph.column])
-        v = np.concatenate(values)
+                values.append(self._column_values(glyph.column))
+                if glyph.kind == "area":
+                    values.append(np.zeros(1))
+                if glyph.kind == "band":
+                    values.append(self._column_values(glyph.upper))
+        v = np.concatenate(values) if values else np.zeros(0)
         v = v[np.isfinite(v)]
         if panel.y_log:
             v = v[v > 0]
             if v.size == 0:
                 raise KalmanInputError(f"Panneau « {panel.title} » : échelle log sans valeur strictement positive.")
             return 10.0 ** np.floor(np.log10(v.min())), 10.0 ** np.ceil(np.log10(v.max()))
+        if v.size == 0:
+            raise KalmanInputError(f"Panneau « {panel.title} » : aucune valeur finie à tracer, donnez « y_range ».")
         lo, hi = float(v.min()), float(v.max())
         pad = 0.05 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.05
         return lo - pad, hi + pad
 
+    def _sources(self):
+        """Une source tracée par longueur de série (« t » et séries du temps commun ensemble), et la
+        grille aplatie correspondante ; renvoie ``(sources, grids, names, lengths, source_of)``."""
+        grid = self.grid
+        T = grid.time.size
+        current = grid.run(*grid.default_index)
+        by_length: dict[int, dict[str, np.ndarray]] = {T: {"t": np.array(grid.time)}}
+        for key, values in self.fixed.items():
+            by_length.setdefault(values.size, {})[key] = np.array(values)
+        for key, values in current.items():
+            by_length.setdefault(values.size, {})[key] = np.array(values)
+        sources, grids, names, lengths, source_of = [], [], [], [], {}
+        for length, columns in by_length.items():
+            source = ColumnDataSource(columns, name=plotted_source_name(length, T))
+            for key in columns:
+                source_of[key] = source
+            computed = [key for key in columns if key in grid.series]
+            if computed:
+                sources.append(source)
+                grids.append(ColumnDataSource({key: grid.flat(key) for key in computed},
+                                              name=f"kc-grid-{length}"))
+                names.append(computed)
+                lengths.append(length)
+        return sources, grids, names, lengths, source_of
+
     def _build(self):
         grid = self.grid
-        i0, j0 = grid.default_index
-        plotted = {"t": np.array(grid.time)}
-        plotted.update(self.fixed)
-        plotted.update({key: np.array(values) for key, values in grid.run(i0, j0).items()})
-        source = ColumnDataSource(plotted, name=PLOTTED_SOURCE)
-        flat = ColumnDataSource({key: grid.flat(key) for key in grid.series}, name="kc-grid")
+        sources, grids, names, lengths, source_of = self._sources()
 
         figures = []
         time_range = Range1d(float(grid.time[0]) - 0.5, float(grid.time[-1]) + 0.5)
@@ -186,7 +248,10 @@ class StaticSliders:
             if panel.equal_aspect:
                 # même échelle en x et en y : rapport largeur/hauteur fixé par les bornes
                 (x0, x1), (y0, y1) = panel.x_range, y_range
-                size = {"aspect_ratio": (x1 - x0) / (y1 - y0), "sizing_mode": "scale_width"}
+                ratio = abs((x1 - x0) / (y1 - y0))
+                size = {"aspect_ratio": ratio, "sizing_mode": "scale_width"}
+                if panel.width is not None:
+                    size = {"width": panel.width, "height": int(round(panel.width / ratio)), "sizing_mode": "fixed"}
             fig = figure(
                 title=panel.title,
                 tools="pan,box_zoom,wheel_zoom,reset,save",
@@ -194,47 +259,78 @@ class StaticSliders:
                 x_range=Range1d(*panel.x_range) if panel.own_x else time_range,
                 y_range=Range1d(*y_range),
                 y_axis_type="log" if panel.y_log else "linear",
+                x_axis_type="log" if panel.x_log else "linear",
                 **size,
             )
             fig.toolbar.logo = None  # pas de lien sortant vers bokeh.org
             fig.toolbar.autohide = True
             fig.xaxis.axis_label = panel.x_label or self.x_label
             fig.yaxis.axis_label = panel.y_label
+            # graduations en français (virgule décimale, × 10ⁿ), sur les axes linéaires et logarithmiques
+            fig.xaxis.formatter = bokeh_tick_formatter()
+            fig.yaxis.formatter = bokeh_tick_formatter()
             items = []
             for glyph in panel.glyphs:
-                if glyph.kind == "line":
-                    r = fig.line(glyph.x, glyph.column, source=source, color=glyph.color, line_width=2)
-                elif glyph.kind == "scatter":
-                    r = fig.scatter(glyph.x, glyph.column, source=source, color=glyph.color, marker="cross", size=8)
-                else:
-                    x0, x1 = panel.x_range if panel.own_x else (float(grid.time[0]), float(grid.time[-1]))
-                    r = fig.line([x0, x1], [glyph.value, glyph.value], color=glyph.color, line_width=1.5)
-                items.append(LegendItem(label=glyph.legend, renderers=[r]))
+                r = self._glyph(fig, panel, glyph, source_of)
+                if glyph.legend:
+                    items.append(LegendItem(label=glyph.legend, renderers=[r]))
             # légende au-dessus du tracé : elle ne cache jamais les courbes
-            fig.add_layout(
-                Legend(items=items, orientation="horizontal", location="top_left", label_text_font_size="9pt",
-                       border_line_alpha=0, margin=0, padding=2),
-                "above",
-            )
+            if items:
+                fig.add_layout(
+                    Legend(items=items, orientation="horizontal", location="top_left", label_text_font_size="9pt",
+                           border_line_alpha=0, margin=0, padding=2),
+                    "above",
+                )
             figures.append(fig)
 
-        s0, s1 = self._sliders()
+        sliders = self._sliders()
+        readout = None
+        texts: list[str] = []
+        if self.readout is not None:
+            texts = [str(self.readout(index)) for index in itertools.product(*(range(n) for n in grid.shape))]
+            readout = Div(text=texts[int(np.ravel_multi_index(grid.default_index, grid.shape))],
+                          name="kc-readout", css_classes=["kc-readout"], sizing_mode="stretch_width")
         callback = CustomJS(
             args={
-                "s0": s0,
-                "s1": s1,
-                "source": source,
-                "grid": flat,
-                "names": list(grid.series),
-                "n1": int(grid.shape[1]),
-                "n_time": int(grid.time.size),
+                "sliders": sliders,
+                "dims": [int(n) for n in grid.shape],
+                "sources": sources,
+                "grids": grids,
+                "names": names,
+                "lengths": lengths,
+                "readout": readout,
+                "texts": texts,
             },
             code=_CALLBACK,
         )
-        s0.js_on_change("value", callback)
-        s1.js_on_change("value", callback)
+        for slider in sliders:
+            slider.js_on_change("value", callback)
         header = [Div(text=f"<strong>{html.escape(self.title)}</strong>")] if self.title else []
-        return column(*header, row(s0, s1, sizing_mode="stretch_width"), *figures, sizing_mode="stretch_width")
+        controls = [row(*sliders, sizing_mode="stretch_width")] + ([readout] if readout is not None else [])
+        return column(*header, *controls, *figures, sizing_mode="stretch_width")
+
+    def _glyph(self, fig, panel: Panel, glyph, source_of):
+        """Dessine un tracé ; renvoie son « renderer » Bokeh."""
+        style = {"color": glyph.color, "alpha": glyph.alpha}
+        if glyph.kind in ("hline", "vline"):
+            x0, x1 = panel.x_range if panel.own_x else (float(self.grid.time[0]), float(self.grid.time[-1]))
+            if glyph.kind == "hline":
+                xs, ys = [x0, x1], [glyph.value, glyph.value]
+            else:
+                xs, ys = [glyph.value, glyph.value], list(self._y_range(panel))
+            return fig.line(xs, ys, color=glyph.color, line_width=glyph.width, line_dash=glyph.dash,
+                            alpha=glyph.alpha)
+        source = source_of[glyph.column]
+        if glyph.kind == "line":
+            return fig.line(glyph.x, glyph.column, source=source, line_width=glyph.width, line_dash=glyph.dash,
+                            **style)
+        if glyph.kind == "scatter":
+            return fig.scatter(glyph.x, glyph.column, source=source, marker=glyph.marker, size=glyph.size, **style)
+        if glyph.kind == "area":
+            return fig.varea(x=glyph.x, y1=0.0, y2=glyph.column, source=source, fill_color=glyph.color,
+                             fill_alpha=0.25 * glyph.alpha)
+        return fig.varea(x=glyph.x, y1=glyph.column, y2=glyph.upper, source=source, fill_color=glyph.color,
+                         fill_alpha=0.25 * glyph.alpha)
 
     # ------------------------------------------------------------------ sortie HTML
 
@@ -273,9 +369,6 @@ class StaticSliders:
         return self.html()
 
     def __repr__(self) -> str:
-        n0, n1 = self.grid.shape
-        a0, a1 = self.grid.axes
-        return (
-            f"<Figure à curseurs statiques « {self.name} » : {a0.symbol} × {a1.symbol}, "
-            f"{n0} × {n1} exécutions précalculées>"
-        )
+        symbols = " × ".join(a.symbol for a in self.grid.axes)
+        sizes = " × ".join(map(str, self.grid.shape))
+        return f"<Figure à curseurs statiques « {self.name} » : {symbols}, {sizes} exécutions précalculées>"

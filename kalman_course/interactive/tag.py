@@ -13,6 +13,7 @@ import numpy as np
 
 from ..scenarios.tag import TAG_ACCEL_STD, TAG_RANGE_STD, TAG_ROOM, run_tag_ekf, tag_data
 from ..core.validation import KalmanInputError, as_float_array
+from .figure import SliderSpec, register_sliders
 from .grid import ParameterAxis, ParameterGrid, log_grid, precompute_grid
 from .spec import Glyph, Panel
 
@@ -120,5 +121,23 @@ def live_tag_explorer(accel_std: float = TAG_ACCEL_STD, range_std: float = TAG_R
         time=data.t,
         panels=tag_panels(),
         x_label="temps t (s)",
+        fixed=_fixed(data),
+    )
+
+
+@register_sliders("tag-curseurs", chapter="suivi-tag")
+def tag_spec(per_decade: int = 3) -> SliderSpec:
+    r"""La figure :math:`(\sigma_a, \sigma_r)` du chapitre au registre des figures à curseurs (même grille
+    que :func:`tag_grid`, mêmes panneaux que :func:`tag_sliders`)."""
+    data = tag_data()
+    return SliderSpec(
+        name="tag-curseurs",
+        chapter="suivi-tag",
+        title=f"Tag UWB : réglez l'EKF (mêmes distances mesurées, {data.t[-1]:.0f} s)",
+        x_label="temps t (s)",
+        axes=tag_axes(per_decade),
+        run=lambda a, r: tag_run(a, r, data=data),
+        time=data.t,
+        panels=tag_panels(),
         fixed=_fixed(data),
     )

@@ -13,6 +13,7 @@ import numpy as np
 from ..filters.kalman import kalman_filter
 from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
 from ..core.validation import KalmanInputError, as_float_array
+from .figure import SliderSpec, register_sliders
 from .grid import ParameterAxis, ParameterGrid, log_grid, precompute_grid
 from .spec import Glyph, Panel
 
@@ -146,5 +147,23 @@ def live_voltage_explorer(Q: float = VOLTAGE_Q, R: float = VOLTAGE_R, P0: float 
         time=np.arange(1, n_steps + 1, dtype=float),
         panels=voltage_panels(),
         x_label="itération n (sans unité)",
+        fixed={"z": constant_voltage_measurements(n_steps)},
+    )
+
+
+@register_sliders("tension-curseurs", chapter="tension-constante")
+def voltage_spec(n_steps: int = 50, per_decade: int = 2) -> SliderSpec:
+    r"""La figure :math:`(\Phi, \Psi)` du chapitre au registre des figures à curseurs (même grille que
+    :func:`voltage_grid`, mêmes panneaux que :func:`voltage_sliders`)."""
+    q_axis, r_axis = voltage_axes(per_decade)
+    return SliderSpec(
+        name="tension-curseurs",
+        chapter="tension-constante",
+        title=f"Tension constante : déplacez Φ et Ψ (x̂₀ = 0 V, P₀ = 1 V², {n_steps} relevés)",
+        x_label="itération n (sans unité)",
+        axes=(q_axis, r_axis),
+        run=lambda Q, R: voltage_run(Q, R, n_steps=n_steps),
+        time=np.arange(1, n_steps + 1, dtype=float),
+        panels=voltage_panels(),
         fixed={"z": constant_voltage_measurements(n_steps)},
     )

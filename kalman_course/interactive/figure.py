@@ -1,0 +1,232 @@
+r"""Le registre des figures à curseurs : une description par figure, deux rendus (statique et vivant).
+
+Chaque chapitre décrit sa figure interactive **une fois** par une :class:`SliderSpec` : les axes des
+curseurs (:class:`~.grid.ParameterAxis`), la fonction ``run`` qui calcule une exécution par le paquet
+(elle appelle une expérience de :mod:`kalman_course.scenarios`), les panneaux (:class:`~.spec.Panel`)
+et, au besoin, un texte de lecture (les nombres de l'exécution affichée, en français). La description
+donne :
+
+- la **figure statique** du livre publié (:meth:`SliderSpec.static`, Bokeh, toutes les exécutions
+  précalculées sur la grille, aucun noyau) ;
+- les **curseurs vivants** de Jupyter (:meth:`SliderSpec.live`, ipywidgets, le filtre relancé pour
+  n'importe quelle valeur).
+
+Une fonction ``() -> SliderSpec`` s'inscrit au registre par :func:`register_sliders` ; un chapitre
+affiche sa figure par ``kc.interactive.sliders("nom")``, et ``kc.interactive.live_explorer("nom")``
+donne les curseurs vivants.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import numpy as np
+
+from ..core.validation import KalmanInputError, as_float_array
+from .grid import ParameterAxis, ParameterGrid, precompute_grid
+from .spec import Panel
+
+__all__ = [
+    "SliderSpec",
+    "SLIDER_FIGURES",
+    "register_sliders",
+    "slider_names",
+    "slider_spec",
+    "slider_grid",
+    "sliders",
+    "live_explorer",
+    "ellipse_outline",
+    "number",
+    "subscript",
+]
+
+
+@dataclass(eq=False)
+class SliderSpec:
+    """Une figure à curseurs, décrite une fois.
+
+    ``name`` : identifiant court (attribut HTML) ; ``chapter`` : page du livre ; ``title`` : titre
+    affiché au-dessus des curseurs ; ``x_label`` : abscisse commune, avec unité ; ``axes`` : un à trois
+    :class:`~.grid.ParameterAxis` (un par curseur) ; ``run(*valeurs) -> dict nom → (L,)`` : une exécution
+    du paquet ; ``time`` (T,) : abscisse commune ; ``panels`` : les panneaux ; ``fixed`` : séries
+    indépendantes des curseurs ; ``readout(séries, valeurs) -> str`` : le texte affiché sous les
+    curseurs (facultatif).
+    """
+
+    name: str
+    chapter: str
+    title: str
+    x_label: str
+    axes: tuple[ParameterAxis, ...]
+    run: Callable[..., Mapping[str, np.ndarray]]
+    time: np.ndarray
+    panels: tuple[Panel, ...]
+    fixed: Mapping[str, np.ndarray] = field(default_factory=dict)
+    readout: Callable[[Mapping[str, np.ndarray], tuple[float, ...]], str] | None = None
+
+    def __post_init__(self) -> None:
+        self.axes = tuple(self.axes)
+        if not 1 <= len(self.axes) <= 3 or not all(isinstance(a, ParameterAxis) for a in self.axes):
+            raise KalmanInputError(f"« axes » de « {self.name} » : un à trois ParameterAxis attendus.")
+        if not callable(self.run):
+            raise KalmanInputError(f"« run » de « {self.name} » doit être une fonction.")
+        self.time = as_float_array("time", self.time)
+        self.panels = tuple(self.panels)
+        self._grid: ParameterGrid | None = None
+
+    @property
+    def live_hint(self) -> str:
+        """L'appel qui donne les curseurs vivants dans Jupyter."""
+        return f'kc.interactive.live_explorer("{self.name}")'
+
+    def grid(self) -> ParameterGrid:
+        """Toutes les exécutions de la grille (calculées une fois, puis gardées : elles sont immuables)."""
+        if self._grid is None:
+            self._grid = precompute_grid(self.run, *self.axes, time=self.time)
+        return self._grid
+
+    def text_at(self, *index: int) -> str:
+        """Le texte de lecture au point de grille ``index`` (vide sans ``readout``)."""
+        if self.readout is None:
+            return ""
+        grid = self.grid()
+        return self.readout(grid.run(*index), grid.values_at(*index))
+
+    def static(self):
+        """La figure à curseurs statiques (Bokeh) du livre publié."""
+        from .static import StaticSliders
+
+        return StaticSliders(
+            self.grid(),
+            self.panels,
+            x_label=self.x_label,
+            fixed=dict(self.fixed),
+            name=self.name,
+            title=self.title,
+            live_hint=self.live_hint,
+            readout=None if self.readout is None else (lambda index: self.text_at(*index)),
+        )
+
+    def live_parameters(self) -> tuple:
+        """Les curseurs vivants équivalents aux axes : logarithmique, linéaire ou à positions."""
+        from .live import ChoiceParameter, LinearParameter, LogParameter
+
+        out = []
+        for axis in self.axes:
+            label = f"{axis.symbol} ({axis.description})"
+            lo, hi = float(axis.values[0]), float(axis.values[-1])
+            if axis.scale == "log":
+                # bornes élargies d'un cheveu : 10**log10(v) peut différer de v au dernier bit
+                out.append(LogParameter(axis.name, label, axis.unit, axis.default_value,
+                                        math.log10(lo) - 1e-9, math.log10(hi) + 1e-9, step=0.05))
+            elif axis.scale == "linear":
+                out.append(LinearParameter(axis.name, label, axis.unit, axis.default_value, lo, hi,
+                                           step=(hi - lo) / 200.0))
+            else:
+                out.append(ChoiceParameter(axis.name, label, tuple(float(v) for v in axis.values),
+                                           tuple(axis.labels()), axis.default_value))
+        return tuple(out)
+
+    def live(self):
+        """Les curseurs vivants (ipywidgets) : ``run`` relancé à chaque relâchement (noyau requis)."""
+        from .live import LiveExplorer
+
+        names = [axis.name for axis in self.axes]
+        readout = None
+        if self.readout is not None:
+            readout = lambda series, values: self.readout(series, tuple(values[n] for n in names))  # noqa: E731
+        return LiveExplorer(
+            run=lambda **values: self.run(*(values[n] for n in names)),
+            parameters=self.live_parameters(),
+            time=self.time,
+            panels=self.panels,
+            x_label=self.x_label,
+            fixed=dict(self.fixed),
+            readout=readout,
+        )
+
+
+#: Le registre : nom → (chapitre, fonction qui construit la description).
+SLIDER_FIGURES: dict[str, tuple[str, Callable[[], SliderSpec]]] = {}
+_SPECS: dict[str, SliderSpec] = {}
+
+
+def register_sliders(name: str, *, chapter: str):
+    """Décorateur : inscrit une fonction ``() -> SliderSpec`` sous ``name`` (unique)."""
+
+    def decorator(func: Callable[[], SliderSpec]) -> Callable[[], SliderSpec]:
+        if name in SLIDER_FIGURES:
+            raise RuntimeError(f"Figure à curseurs « {name} » déjà enregistrée.")
+        SLIDER_FIGURES[name] = (chapter, func)
+        return func
+
+    return decorator
+
+
+def slider_names(chapter: str | None = None) -> list[str]:
+    """Noms des figures à curseurs (toutes, ou celles d'un chapitre)."""
+    return [n for n, (c, _) in SLIDER_FIGURES.items() if chapter is None or c == chapter]
+
+
+def slider_spec(name: str) -> SliderSpec:
+    """La description de la figure ``name`` (construite une fois)."""
+    if name not in SLIDER_FIGURES:
+        raise KalmanInputError(
+            f"Figure à curseurs inconnue « {name} ». Figures disponibles : {', '.join(SLIDER_FIGURES)}."
+        )
+    if name not in _SPECS:
+        spec = SLIDER_FIGURES[name][1]()
+        if spec.name != name:
+            raise RuntimeError(f"La figure inscrite sous « {name} » se nomme « {spec.name} ».")
+        _SPECS[name] = spec
+    return _SPECS[name]
+
+
+def slider_grid(name: str) -> ParameterGrid:
+    """La grille précalculée de la figure ``name``."""
+    return slider_spec(name).grid()
+
+
+def sliders(name: str):
+    """La figure à curseurs statiques ``name`` (à afficher dans le livre : aucun noyau nécessaire)."""
+    return slider_spec(name).static()
+
+
+def live_explorer(name: str):
+    """Les curseurs vivants de la figure ``name`` (Jupyter, Binder, Colab : un noyau doit tourner)."""
+    return slider_spec(name).live()
+
+
+_SUBSCRIPT = str.maketrans("0123456789-", "₀₁₂₃₄₅₆₇₈₉₋")
+
+
+def subscript(n: int) -> str:
+    """Un entier en indice : ``subscript(12)`` → « ₁₂ »."""
+    return str(int(n)).translate(_SUBSCRIPT)
+
+
+def number(value: float, unit: str | None = None, significant: int = 3) -> str:
+    """Un nombre du paquet écrit en français (:func:`kalman_course.numbers.format_number`), sans les zéros
+    finals de la partie décimale : « 0,8 », « 4 », « 3,2 × 10⁻⁴ »."""
+    from ..numbers import format_number
+
+    text = format_number(float(value), significant=significant)
+    head, sep, tail = text.partition("\u202f×")
+    if "," in head:
+        head = head.rstrip("0").rstrip(",")
+    text = head + sep + tail
+    return text if unit is None else f"{text}\u00a0{unit}"
+
+
+def ellipse_outline(mean, cov, scale: float = 2.0, n_points: int = 73) -> tuple[np.ndarray, np.ndarray]:
+    r"""Contour de l'ellipse :math:`\{m + \text{scale}\,L(\cos t, \sin t)\}`, :math:`LL^T` = ``cov`` (2, 2) :
+    l'ellipse à ``scale`` écarts-types d'une loi gaussienne plane. Renvoie ``(x, y)``, formes (n_points,)."""
+    mean = as_float_array("mean", mean).reshape(2)
+    cov = as_float_array("cov", cov).reshape(2, 2)
+    lam, V = np.linalg.eigh(0.5 * (cov + cov.T))
+    L = V * np.sqrt(np.clip(lam, 0.0, None))
+    t = np.linspace(0.0, 2.0 * np.pi, n_points)
+    pts = mean[:, None] + scale * L @ np.vstack([np.cos(t), np.sin(t)])
+    return pts[0], pts[1]
