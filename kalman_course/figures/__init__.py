@@ -4,6 +4,7 @@ Les chapitres appellent ``draw`` ; la commande ``python -m kalman_course.figures
 figures dans des fichiers (diapositives, polycopiés). Une figure = une fonction à graine fixe.
 """
 
+from . import intuition  # noqa: F401  (chapitre « Le filtre de Kalman en images »)
 from . import system  # noqa: F401  (chapitre « Contrôle d'un système dynamique »)
 from . import estimator  # noqa: F401  (chapitre « Construction d'un estimateur »)
 from . import gain  # noqa: F401  (chapitres « Prédicteur–correcteur » et « Gain optimal »)

@@ -34,13 +34,18 @@ PRODUCT_POSITIONS = np.round(np.arange(0.0, 25.0001, 0.1), 10)
 _EVERY = 5
 
 
+#: Variances proposées (m²) pour :math:`P^-` et :math:`R` : des puissances de 2, pour que les deux curseurs
+#: puissent prendre la même valeur ; l'exemple du chapitre est :math:`P^- = 4`, :math:`R = 1`.
+VARIANCES = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0)
+
+
 def product_axes() -> tuple[ParameterAxis, ParameterAxis]:
-    r""":math:`P^- \in [0{,}4 ; 40]` m² et :math:`R \in [0{,}1 ; 10]` m², quatre points par décade, centrés
-    sur l'exemple du chapitre (4 m² et 1 m²)."""
+    r""":math:`P^-` et :math:`R` parcourent :data:`VARIANCES` (4 m² et 1 m² par défaut)."""
     return (
-        ParameterAxis("prior_var", "P⁻", "variance a priori", "m²", log_grid(sc.PRIOR_VAR, 1, 1, 4), default=4),
-        ParameterAxis("meas_var", "R", "variance de la mesure", "m²", log_grid(sc.MEASUREMENT_VAR, 1, 1, 4),
-                      default=4),
+        ParameterAxis("prior_var", "P⁻", "variance a priori", "m²", np.array(VARIANCES),
+                      default=VARIANCES.index(sc.PRIOR_VAR)),
+        ParameterAxis("meas_var", "R", "variance de la mesure", "m²", np.array(VARIANCES),
+                      default=VARIANCES.index(sc.MEASUREMENT_VAR)),
     )
 
 

@@ -77,6 +77,22 @@ if (readout !== null) readout.text = texts[k];
 """
 
 
+#: Largeur (px) que l'on peut compter pour une ligne de légende dans la colonne du livre.
+LEGEND_WIDTH = 600
+
+
+def _legend_rows(items) -> int:
+    """Nombre de lignes de la légende pour qu'elle tienne dans la colonne du livre (largeur estimée :
+    6,3 px par caractère en 9 pt, plus le symbole)."""
+    widths = [6.3 * len(item.label.value if hasattr(item.label, "value") else str(item.label)) + 40 for item in items]
+    rows, used = 1, 0.0
+    for w in widths:
+        if used and used + w > LEGEND_WIDTH:
+            rows, used = rows + 1, 0.0
+        used += w
+    return rows
+
+
 def plotted_source_name(length: int, time_length: int) -> str:
     """Nom de la source tracée des séries de longueur ``length`` : :data:`PLOTTED_SOURCE` pour celles
     du temps commun, ``kc-plotted-<longueur>`` pour les autres."""
@@ -278,7 +294,7 @@ class StaticSliders:
             if items:
                 fig.add_layout(
                     Legend(items=items, orientation="horizontal", location="top_left", label_text_font_size="9pt",
-                           border_line_alpha=0, margin=0, padding=2),
+                           border_line_alpha=0, margin=0, padding=2, nrows=_legend_rows(items)),
                     "above",
                 )
             figures.append(fig)

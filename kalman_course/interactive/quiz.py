@@ -1,0 +1,316 @@
+r"""Extension Sphinx du livre : la directive ``quiz``, questionnaires corrigés dans la page, hors ligne.
+
+À déclarer dans ``_config.yml`` (``sphinx: extra_extensions: [kalman_course.interactive.quiz]``). Dans un
+chapitre (MyST) :
+
+.. code-block:: markdown
+
+    ::::{quiz}
+    :::{question}
+    :answer: 2
+    Quand la variance de mesure $R$ diminue, le gain $K$…
+
+    - diminue ;
+    - augmente ;
+    - ne change pas.
+
+    $K = P^-/(P^- + R)$ croît quand $R$ décroît : la mesure, plus précise, pèse davantage.
+    :::
+    ::::
+
+Dans une question, ce qui précède la **première liste à puces** est l'énoncé, les éléments de la liste
+sont les réponses proposées (``:answer:`` : numéro de la bonne, à partir de 1), ce qui suit est
+l'explication. ``:name:`` donne un identifiant stable à la question (pour les tests).
+
+- **HTML** : chaque question est un groupe de boutons radio, un bouton « Vérifier » et une zone de
+  réponse ; quelques lignes de JavaScript sans dépendance, ajoutées une fois aux seules pages qui ont
+  un quiz, comparent le choix à la bonne réponse, l'annoncent (« Juste ! » ou « Pas tout à fait ») et
+  déplient l'explication. Aucun serveur, aucun noyau, aucune requête.
+- **Autres sorties** (LaTeX/PDF, texte) : les questions deviennent une liste numérotée, les réponses
+  proposées des sous-listes (a), (b), (c)… et les bonnes réponses, avec leur explication, sont
+  regroupées dans une section « Réponses du quiz » à la fin du chapitre.
+"""
+
+from __future__ import annotations
+
+import re
+
+from docutils import nodes
+from docutils.parsers.rst import directives
+from sphinx.util import logging
+from sphinx.util.docutils import SphinxDirective
+
+__all__ = ["setup", "QUIZ_MARKER", "QUIZ_SCRIPT", "quiz", "quiz_question"]
+
+LOGGER = logging.getLogger(__name__)
+
+#: Classe HTML d'un quiz (repérée par l'extension pour ajouter le script, et par les tests).
+QUIZ_MARKER = "kc-quiz"
+_LETTERS = "abcdefghijklmnopqrstuvwxyz"
+_NBSP = "\u00a0"
+
+
+class quiz(nodes.General, nodes.Element):
+    """Un questionnaire : ses enfants sont des :class:`quiz_question`."""
+
+
+class quiz_question(nodes.General, nodes.Element):
+    """Une question : ``answer`` (numéro de la bonne réponse, à partir de 1), ``number``, ``qid``."""
+
+
+class quiz_statement(nodes.General, nodes.Element):
+    """L'énoncé d'une question."""
+
+
+class quiz_choices(nodes.General, nodes.Element):
+    """Les réponses proposées (enfants :class:`quiz_choice`)."""
+
+
+class quiz_choice(nodes.General, nodes.TextElement):
+    """Une réponse proposée (contenu en ligne) ; ``index`` à partir de 1."""
+
+
+class quiz_explanation(nodes.General, nodes.Element):
+    """L'explication, dépliée après la première vérification."""
+
+
+class QuizDirective(SphinxDirective):
+    """``quiz`` : un conteneur de questions (titre facultatif en argument)."""
+
+    has_content = True
+    optional_arguments = 1
+    final_argument_whitespace = True
+
+    def run(self):
+        node = quiz()
+        node["title"] = self.arguments[0] if self.arguments else ""
+        self.set_source_info(node)
+        self.state.nested_parse(self.content, self.content_offset, node)
+        questions = [c for c in node.children if isinstance(c, quiz_question)]
+        if not questions or len(questions) != len(node.children):
+            return [self._error("un quiz ne contient que des questions (directive « question »), au moins une.")]
+        return [node]
+
+    def _error(self, text: str):
+        return self.state.document.reporter.error(f"quiz : {text}", line=self.lineno)
+
+
+class QuestionDirective(SphinxDirective):
+    """``question`` : énoncé, liste des réponses proposées, explication."""
+
+    has_content = True
+    option_spec = {"answer": directives.positive_int, "name": directives.unchanged}
+
+    def run(self):
+        if "answer" not in self.options:
+            return [self._error("l'option « :answer: » (numéro de la bonne réponse, à partir de 1) manque.")]
+        body = nodes.container()
+        self.state.nested_parse(self.content, self.content_offset, body)
+        lists = [i for i, c in enumerate(body.children) if isinstance(c, nodes.bullet_list)]
+        if not lists:
+            return [self._error("aucune liste à puces : les réponses proposées forment la première liste.")]
+        k = lists[0]
+        items = body.children[k].children
+        answer = self.options["answer"]
+        if len(items) < 2 or not 1 <= answer <= len(items):
+            return [self._error(f"{len(items)} réponse(s) proposée(s) et « :answer: {answer} » : il faut au moins "
+                                "deux réponses et un numéro de bonne réponse parmi elles.")]
+        question = quiz_question(answer=answer, name=self.options.get("name", ""))
+        self.set_source_info(question)
+        statement = quiz_statement()
+        statement.extend(body.children[:k])
+        choices = quiz_choices()
+        for index, item in enumerate(items, start=1):
+            choice = quiz_choice(index=index)
+            content = item.children
+            # un seul paragraphe : son contenu en ligne (un <label> n'admet pas de <p>)
+            if len(content) == 1 and isinstance(content[0], nodes.paragraph):
+                content = content[0].children
+            choice.extend([c.deepcopy() for c in content])
+            choices += choice
+        explanation = quiz_explanation()
+        explanation.extend(body.children[k + 1:])
+        question += [statement, choices, explanation]
+        return [question]
+
+    def _error(self, text: str):
+        return self.state.document.reporter.error(f"question de quiz : {text}", line=self.lineno)
+
+
+# --------------------------------------------------------------------------- numérotation
+
+
+def _number_questions(app, doctree, docname: str) -> list[quiz_question]:
+    questions = list(doctree.findall(quiz_question))
+    slug = re.sub(r"[^a-z0-9]+", "-", docname.lower()).strip("-")
+    for k, q in enumerate(questions, start=1):
+        q["number"] = k
+        q["qid"] = f"kc-quiz-{slug}-{k}"
+    return questions
+
+
+# --------------------------------------------------------------------------- HTML
+
+#: Le script ajouté une fois aux pages qui ont un quiz : styles et vérification des réponses.
+QUIZ_SCRIPT = r"""
+(function () {
+  if (window.kcQuizReady) return;
+  window.kcQuizReady = true;
+  var css = ".kc-quiz{border:1px solid #d0d7de;border-radius:6px;padding:.6em 1em;margin:1em 0}" +
+    ".kc-quiz-question{border:0;border-top:1px solid #eaeef2;padding:.6em 0;margin:0}" +
+    ".kc-quiz-question:first-of-type{border-top:0}" +
+    ".kc-quiz-question legend{font-weight:600;font-size:.95em;padding:0}" +
+    ".kc-quiz-choice{display:block;margin:.2em 0;cursor:pointer}" +
+    ".kc-quiz-choice input{margin-right:.5em}" +
+    ".kc-quiz-check{margin:.4em 0;padding:.2em .9em;border:1px solid #888;border-radius:4px;background:#f6f8fa;cursor:pointer}" +
+    ".kc-quiz-feedback{font-weight:600;margin:.2em 0}" +
+    ".kc-quiz-right .kc-quiz-feedback{color:#1a7f37}" +
+    ".kc-quiz-wrong .kc-quiz-feedback{color:#cf222e}" +
+    ".kc-quiz-explanation{margin:.3em 0 .2em 0}" +
+    ".kc-quiz-explanation summary{cursor:pointer;color:#0969da}";
+  var style = document.createElement("style");
+  style.textContent = css;
+  document.head.appendChild(style);
+  document.addEventListener("click", function (event) {
+    var button = event.target.closest ? event.target.closest(".kc-quiz-check") : null;
+    if (!button) return;
+    var question = button.closest(".kc-quiz-question");
+    var chosen = question.querySelector("input[type=radio]:checked");
+    var feedback = question.querySelector(".kc-quiz-feedback");
+    var explanation = question.querySelector(".kc-quiz-explanation");
+    question.classList.remove("kc-quiz-right", "kc-quiz-wrong");
+    if (!chosen) {
+      feedback.textContent = "Choisissez d\u2019abord une r\u00e9ponse.";
+      return;
+    }
+    var right = chosen.value === question.getAttribute("data-answer");
+    question.classList.add(right ? "kc-quiz-right" : "kc-quiz-wrong");
+    feedback.textContent = right ? "Juste\u00a0!" :
+      "Pas tout \u00e0 fait. R\u00e9essayez, ou d\u00e9pliez l\u2019explication.";
+    if (explanation) {
+      explanation.hidden = false;
+      explanation.open = right;
+    }
+  });
+})();
+"""
+
+
+def visit_quiz_html(self, node):
+    self.body.append(f'<div class="{QUIZ_MARKER}" data-kc-quiz="{len(node.children)}">')
+    if node["title"]:
+        self.body.append(f'<p class="kc-quiz-title"><strong>{self.encode(node["title"])}</strong></p>')
+
+
+def depart_quiz_html(self, node):
+    self.body.append("</div>\n")
+
+
+def visit_question_html(self, node):
+    name = f' data-name="{self.attval(node["name"])}"' if node.get("name") else ""
+    self.body.append(f'<fieldset class="kc-quiz-question" id="{node["qid"]}" data-answer="{node["answer"]}"{name}>'
+                     f'<legend>Question {node["number"]}</legend>')
+
+
+def depart_question_html(self, node):
+    self.body.append("</fieldset>\n")
+
+
+def visit_statement_html(self, node):
+    self.body.append('<div class="kc-quiz-statement">')
+
+
+def depart_div_html(self, node):
+    self.body.append("</div>")
+
+
+def visit_choices_html(self, node):
+    self.body.append('<div class="kc-quiz-choices">')
+
+
+def depart_choices_html(self, node):
+    self.body.append('</div><button type="button" class="kc-quiz-check">Vérifier</button>'
+                     '<p class="kc-quiz-feedback" role="status" aria-live="polite"></p>')
+
+
+def visit_choice_html(self, node):
+    qid = node.parent.parent["qid"]
+    self.body.append(f'<label class="kc-quiz-choice"><input type="radio" name="{qid}" value="{node["index"]}">'
+                     '<span>')
+
+
+def depart_choice_html(self, node):
+    self.body.append("</span></label>")
+
+
+def visit_explanation_html(self, node):
+    if not node.children:
+        raise nodes.SkipNode
+    self.body.append('<details class="kc-quiz-explanation" hidden><summary>Explication</summary>')
+
+
+def depart_explanation_html(self, node):
+    self.body.append("</details>")
+
+
+# --------------------------------------------------------------------------- autres sorties (LaTeX…)
+
+
+def _as_plain_nodes(app, doctree, questions: list[quiz_question]) -> None:
+    """Remplace chaque quiz par des listes ordinaires et regroupe les réponses en fin de chapitre."""
+    answers = []
+    for node in list(doctree.findall(quiz)):
+        rubric = nodes.rubric(text=node["title"] or "Quiz")
+        listing = nodes.enumerated_list(enumtype="arabic", prefix="", suffix=".")
+        for q in [c for c in node.children if isinstance(c, quiz_question)]:
+            statement, choices, explanation = q.children
+            item = nodes.list_item()
+            item.extend(statement.children)
+            options = nodes.enumerated_list(enumtype="loweralpha", prefix="(", suffix=")")
+            for choice in choices.children:
+                options += nodes.list_item("", nodes.paragraph("", "", *choice.children))
+            item += options
+            listing += item
+            right = choices.children[q["answer"] - 1]
+            letter = _LETTERS[q["answer"] - 1]
+            head = nodes.paragraph()
+            head += nodes.strong(text=f"Question {q['number']}{_NBSP}: ({letter}) ")
+            head.extend(c.deepcopy() for c in right.children)
+            answers.append([head, *explanation.children])
+        node.replace_self([rubric, listing])
+    if not answers:
+        return
+    section = nodes.section(ids=["kc-quiz-reponses"], names=["réponses du quiz"])
+    section += nodes.title(text="Réponses du quiz")
+    for block in answers:
+        section.extend(block)
+    top = next(iter(doctree.findall(nodes.section)), None)
+    (top if top is not None else doctree).append(section)
+
+
+def _resolve(app, doctree, docname: str) -> None:
+    questions = _number_questions(app, doctree, docname)
+    if not questions:
+        return
+    if app.builder.format != "html":
+        _as_plain_nodes(app, doctree, questions)
+
+
+def _add_script(app, pagename, templatename, context, doctree) -> None:
+    if doctree is not None and next(iter(doctree.findall(quiz_question)), None) is not None:
+        app.add_js_file(None, body=QUIZ_SCRIPT)
+
+
+def setup(app):
+    html = (visit_quiz_html, depart_quiz_html)
+    app.add_node(quiz, html=html)
+    app.add_node(quiz_question, html=(visit_question_html, depart_question_html))
+    app.add_node(quiz_statement, html=(visit_statement_html, depart_div_html))
+    app.add_node(quiz_choices, html=(visit_choices_html, depart_choices_html))
+    app.add_node(quiz_choice, html=(visit_choice_html, depart_choice_html))
+    app.add_node(quiz_explanation, html=(visit_explanation_html, depart_explanation_html))
+    app.add_directive("quiz", QuizDirective)
+    app.add_directive("question", QuestionDirective)
+    app.connect("doctree-resolved", _resolve)
+    app.connect("html-page-context", _add_script)
+    return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}
