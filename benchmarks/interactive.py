@@ -1,7 +1,7 @@
 """Mesures de l'interactivité du livre, comparées aux objectifs (rien n'est un test chronométré).
 
 1. Précalcul des grilles : 15 × 15 exécutions de 50 pas (tension constante), objectif < 1 s ;
-   7 × 7 exécutions de 300 pas de l'EKF du tag, pour information.
+   puis chaque figure à curseurs du registre (une par chapitre au moins), pour information.
 2. Poids de la page interactive (site construit) : HTML propre + données précalculées + images, objectif
    < 1 Mo ; scripts partagés par tout le site (BokehJS, MathJax, thème), chargés une fois, à part.
 3. Réponse des curseurs dans Chromium headless : de l'événement clavier réel (touche flèche sur la
@@ -30,8 +30,20 @@ CHROMIUM_ARGS = [
     "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
     "--disable-background-networking", "--disable-component-update", "--disable-sync",
 ]
-PAGES = ["book/tension-constante.html", "book/suivi-tag.html"]
-PLAIN_PAGE = "book/intro.html"  # page du thème sans figure interactive, pour comparaison
+PLAIN_PAGE = "book/references.html"  # page sans figure interactive, pour comparaison
+
+
+def _pages() -> list[str]:
+    """Les pages du livre qui ont une figure à curseurs, dans l'ordre de la table des matières."""
+    import yaml
+
+    root = Path(__file__).resolve().parent.parent
+    toc = yaml.safe_load((root / "_toc.yml").read_text())
+    files = [toc["root"]] + [c["file"] for part in toc["parts"] for c in part["chapters"]]
+    return [f"{f}.html" for f in files if Path(f).name != "references"]
+
+
+PAGES = _pages()
 
 
 def best_time(func, repeat: int = 5) -> float:
@@ -51,11 +63,20 @@ def bench_grids() -> None:
     n = g.shape[0] * g.shape[1]
     print(f"   tension constante  {g.shape[0]}×{g.shape[1]} exécutions × {g.time.size} pas : {t * 1e3:7.1f} ms"
           f"  (objectif < 1000 ms : {'atteint' if t < 1 else 'MANQUÉ'}, {t / n * 1e6:.0f} µs par exécution)")
-    t = best_time(ki.tag_grid, repeat=2)
-    g = ki.tag_grid()
-    print(f"   tag UWB (EKF)      {g.shape[0]}×{g.shape[1]} exécutions × {g.time.size} pas : {t * 1e3:7.1f} ms")
     t = best_time(lambda: ki.voltage_sliders().html(), repeat=3)
     print(f"   figure Bokeh complète de la tension (grille + document + HTML) : {t * 1e3:7.1f} ms")
+    print("   figures à curseurs du registre (une exécution : grille + document + HTML) :")
+    for name in ki.slider_names():
+        spec_factory = ki.SLIDER_FIGURES[name][1]
+        t0 = time.perf_counter()
+        spec = spec_factory()
+        grid = spec.grid()
+        t1 = time.perf_counter()
+        html = spec.static().html()
+        t2 = time.perf_counter()
+        sizes = " × ".join(map(str, grid.shape))
+        print(f"     {name:28s} {sizes:>8s} points : grille {t1 - t0:6.2f} s, figure {1e3 * (t2 - t1):6.0f} ms, "
+              f"HTML {len(html) / 1e3:5.0f} ko")
 
 
 def serve(root: Path):
@@ -111,7 +132,6 @@ _INSTALL = """(k) => {
   // tPaint : fin du dernier rendu que BokehJS a demandé (requestAnimationFrame) après cet événement,
   // c'est-à-dire les trois panneaux redessinés.
   const doc = Bokeh.documents[k];
-  const src = doc.get_model_by_name('%s');
   window.kcMoves = [];
   let current = null;
   document.addEventListener('keydown', (e) => {
@@ -119,7 +139,8 @@ _INSTALL = """(k) => {
     window.kcMoves.push(current);
   }, true);
   doc.on_change((ev) => {
-    if (current && ev.model === src && ev.attr === 'data') current.tData = performance.now() - current.t0;
+    if (current && ev.attr === 'data' && ev.model.name && ev.model.name.startsWith('%s'))
+      current.tData = performance.now() - current.t0;
   });
   const raf = window.requestAnimationFrame.bind(window);
   window.requestAnimationFrame = (cb) => {
@@ -174,7 +195,8 @@ def bench_browser(root: Path, moves: int) -> None:
                     name = figures.nth(k).get_attribute(MARKER)
                     page.locator(f"[{MARKER}] .noUi-handle").first.wait_for()
                     page.evaluate(_INSTALL, k)
-                    for s in (0, 1):
+                    n_sliders = figures.nth(k).locator(".noUi-handle").count()
+                    for s in range(n_sliders):
                         handle = figures.nth(k).locator(".noUi-handle").nth(s)
                         handle.focus()
                         page.keyboard.press("Home")

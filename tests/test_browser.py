@@ -36,8 +36,8 @@ CHROMIUM_ARGS = [
 # fois son script « const THEBE_JS_URL = … » ; l'extension du livre retire la copie, et
 # page_errors vérifie qu'il n'en reste qu'une.)
 
-#: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet).
-EXPECTED_GRIDS = {"tension-curseurs": ki.voltage_grid, "tag-curseurs": ki.tag_grid}
+#: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet, depuis son registre).
+EXPECTED_GRIDS = {name: (lambda name=name: ki.slider_grid(name)) for name in ki.slider_names()}
 
 
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):
@@ -222,29 +222,40 @@ def test_every_page_is_offline_typeset_and_drawn(site, browser):
 
 # --------------------------------------------------------------------------- curseurs statiques
 
+# Toutes les sources tracées de la figure k (une par longueur de série : PLOTTED_SOURCE, PLOTTED_SOURCE-<L>),
+# la position de chaque curseur et le texte de lecture.
 _READ = """(k) => {
   const doc = Bokeh.documents[k];
-  const src = doc.get_model_by_name('%s');
   const out = {};
-  for (const name of Object.keys(src.data)) out[name] = Array.from(src.data[name]);
-  return {i: doc.get_model_by_name('kc-slider-0').value, j: doc.get_model_by_name('kc-slider-1').value, data: out};
+  for (const m of doc.all_models) {
+    if (m.name && m.name.startsWith('%s') && m.data) {
+      for (const name of Object.keys(m.data)) out[name] = Array.from(m.data[name]);
+    }
+  }
+  const index = [];
+  for (let s = 0; doc.get_model_by_name('kc-slider-' + s); s++) index.push(doc.get_model_by_name('kc-slider-' + s).value);
+  const readout = doc.get_model_by_name('kc-readout');
+  return {index: index, data: out, readout: readout ? readout.text : null};
 }""" % PLOTTED_SOURCE
 
 
-def _check_plotted(page, k: int, grid, root) -> tuple[int, int]:
+def _check_plotted(page, k: int, grid, root, name: str | None = None) -> tuple[int, ...]:
     state = page.evaluate(_READ, k)
-    i, j = state["i"], state["j"]
-    assert float(i).is_integer() and float(j).is_integer()
-    i, j = int(i), int(j)
-    expected = grid.run(i, j)
-    for name, values in expected.items():
-        np.testing.assert_allclose(np.array(state["data"][name], dtype=float), values, rtol=1e-12, atol=0,
-                                   err_msg=f"série {name}, point ({i}, {j})")
+    assert len(state["index"]) == len(grid.axes)
+    assert all(float(v).is_integer() for v in state["index"])
+    index = tuple(int(v) for v in state["index"])
+    expected = grid.run(*index)
+    for series, values in expected.items():
+        np.testing.assert_allclose(np.array(state["data"][series], dtype=float), values, rtol=1e-12, atol=0,
+                                   equal_nan=True, err_msg=f"série {series}, point {index}")
     np.testing.assert_array_equal(state["data"]["t"], grid.time)
     # les curseurs affichent les vraies valeurs du point de grille
-    shown = [root.locator(".bk-slider-value").nth(s).text_content() for s in (0, 1)]
-    assert shown == [grid.axes[0].labels()[i], grid.axes[1].labels()[j]]
-    return i, j
+    shown = [root.locator(".bk-slider-value").nth(s).text_content() for s in range(len(grid.axes))]
+    assert shown == [axis.labels()[i] for axis, i in zip(grid.axes, index)]
+    # le texte de lecture donne les nombres de cette exécution, calculés par le paquet
+    if name is not None and ki.slider_spec(name).readout is not None:
+        assert state["readout"] == ki.slider_spec(name).text_at(*index)
+    return index
 
 
 def _drag(page, handle, base, fraction: float) -> None:
@@ -291,37 +302,38 @@ def test_static_sliders_show_the_package_runs(site, browser, capsys):
             assert fig_name in EXPECTED_GRIDS, f"figure « {fig_name} » inconnue du test : ajoutez sa grille"
             grid = EXPECTED_GRIDS[fig_name]()
             root = figures.nth(k)
+            check = functools.partial(_check_plotted, name=fig_name)
             # position par défaut = la figure statique du chapitre
-            assert _check_plotted(page, k, grid, root) == grid.default_index
-            for s in (0, 1):
+            assert check(page, k, grid, root) == grid.default_index
+            for s in range(len(grid.axes)):
                 handle = root.locator(".noUi-handle").nth(s)
                 base = root.locator(".noUi-base").nth(s)
                 n = grid.shape[s]
                 seen = set()
                 handle.focus()
                 page.keyboard.press("End")
-                pos = _check_plotted(page, k, grid, root)
+                pos = check(page, k, grid, root)
                 assert pos[s] == n - 1
                 seen.add(pos)
                 page.keyboard.press("Home")
-                pos = _check_plotted(page, k, grid, root)
+                pos = check(page, k, grid, root)
                 assert pos[s] == 0
                 for _ in range(3):
                     page.keyboard.press("ArrowRight")
-                pos = _check_plotted(page, k, grid, root)
-                assert pos[s] == 3
+                pos = check(page, k, grid, root)
+                assert pos[s] == min(3, n - 1)
                 _drag(page, handle, base, 0.8)
-                pos = _check_plotted(page, k, grid, root)
+                pos = check(page, k, grid, root)
                 assert abs(pos[s] - 0.8 * (n - 1)) <= 1
                 page.mouse.click(*_point(base, 0.1))  # clic sur la glissière
-                pos = _check_plotted(page, k, grid, root)
+                pos = check(page, k, grid, root)
                 assert abs(pos[s] - 0.1 * (n - 1)) <= 1
                 # retour à la position par défaut, au clavier
                 handle.focus()
                 page.keyboard.press("Home")
                 for _ in range(grid.default_index[s]):
                     page.keyboard.press("ArrowRight")
-                assert _check_plotted(page, k, grid, root)[s] == grid.default_index[s]
+                assert check(page, k, grid, root)[s] == grid.default_index[s]
         assert not visit.blocked and not visit.broken
         assert not page_errors(visit, html_file.read_text()), visit.errors
         sizes = _weight(visit, site, html_file)
@@ -357,3 +369,99 @@ def test_interactive_chapter_works_from_file_url(site, browser):
     assert (i, j) != grid.default_index
     assert not page_errors(visit, html_file.read_text()), visit.errors
     page.context.close()
+
+
+# --------------------------------------------------------------------------- chaque chapitre se manipule
+
+
+def _toc_pages(root: Path) -> list[Path]:
+    import yaml
+
+    toc = yaml.safe_load((ROOT / "_toc.yml").read_text())
+    files = [toc["root"]] + [c["file"] for part in toc["parts"] for c in part["chapters"]]
+    return [root / f"{f}.html" for f in files if Path(f).name != "references"]
+
+
+def _plotted(page, k: int) -> dict:
+    return page.evaluate(_READ, k)["data"]
+
+
+def _differs(before: dict, after: dict) -> bool:
+    return any(not np.array_equal(np.array(before[n], dtype=float), np.array(after.get(n, []), dtype=float),
+                                  equal_nan=True) for n in before)
+
+
+def test_every_chapter_has_a_slider_that_changes_the_plotted_data(site, browser):
+    """Chaque chapitre (introduction comprise) a au moins une figure à curseurs qui marche dans la page
+    publiée, sans noyau : chaque curseur, déplacé par une vraie touche du clavier, change les données
+    tracées, et les données affichées sont celles de la grille du paquet."""
+    problems = []
+    for html_file in _toc_pages(site.root):
+        name = html_file.relative_to(site.root).as_posix()
+        visit = open_page(browser, site.url(html_file), site.base)
+        page = visit.page
+        figures = page.locator(f"[{MARKER}]")
+        if figures.count() == 0:
+            problems.append(f"{name} : aucune figure à curseurs")
+            page.context.close()
+            continue
+        for k in range(figures.count()):
+            fig_name = figures.nth(k).get_attribute(MARKER)
+            root = figures.nth(k)
+            grid = EXPECTED_GRIDS[fig_name]()
+            for s in range(len(grid.axes)):
+                before = _plotted(page, k)
+                handle = root.locator(".noUi-handle").nth(s)
+                handle.focus()
+                at_end = grid.default_index[s] == grid.shape[s] - 1
+                page.keyboard.press("ArrowLeft" if at_end else "ArrowRight")
+                after = _plotted(page, k)
+                if not _differs(before, after):
+                    problems.append(f"{name} : le curseur {s} de « {fig_name} » ne change pas les données tracées")
+                _check_plotted(page, k, grid, root, fig_name)
+                page.keyboard.press("ArrowRight" if at_end else "ArrowLeft")  # retour
+        if page_errors(visit, html_file.read_text()):
+            problems.append(f"{name} : erreurs de page {visit.errors}")
+        page.context.close()
+    assert not problems, "\n".join(problems)
+
+
+def test_every_quiz_marks_a_right_and_a_wrong_answer(site, browser):
+    """Chaque question de chaque quiz, dans la page publiée : une mauvaise réponse est marquée fausse,
+    la bonne est marquée juste, et l'explication se déplie ; tout se passe dans la page (aucune requête)."""
+    problems = []
+    for html_file in _toc_pages(site.root):
+        name = html_file.relative_to(site.root).as_posix()
+        visit = open_page(browser, site.url(html_file), site.base)
+        page = visit.page
+        questions = page.locator(".kc-quiz .kc-quiz-question")
+        n = questions.count()
+        if not 3 <= n <= 5:
+            problems.append(f"{name} : {n} question(s) de quiz")
+        loaded = len(visit.loaded)
+        for q in range(n):
+            question = questions.nth(q)
+            answer = int(question.get_attribute("data-answer"))
+            radios = question.locator("input[type=radio]")
+            wrong = 1 if answer != 1 else 2
+            radios.nth(wrong - 1).check()
+            question.locator(".kc-quiz-check").click()
+            classes = question.get_attribute("class").split()
+            feedback = question.locator(".kc-quiz-feedback").text_content()
+            if "kc-quiz-wrong" not in classes or not feedback.startswith("Pas tout"):
+                problems.append(f"{name} : question {q + 1}, une mauvaise réponse n'est pas marquée fausse")
+            radios.nth(answer - 1).check()
+            question.locator(".kc-quiz-check").click()
+            classes = question.get_attribute("class").split()
+            feedback = question.locator(".kc-quiz-feedback").text_content()
+            if "kc-quiz-right" not in classes or not feedback.startswith("Juste"):
+                problems.append(f"{name} : question {q + 1}, la bonne réponse n'est pas marquée juste")
+            explanation = question.locator(".kc-quiz-explanation")
+            if explanation.count() and not explanation.is_visible():
+                problems.append(f"{name} : question {q + 1}, l'explication reste cachée")
+        if len(visit.loaded) != loaded or visit.blocked:
+            problems.append(f"{name} : le quiz a fait des requêtes")
+        if page_errors(visit, html_file.read_text()):
+            problems.append(f"{name} : erreurs de page {visit.errors}")
+        page.context.close()
+    assert not problems, "\n".join(problems)

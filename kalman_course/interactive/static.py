@@ -305,7 +305,8 @@ class StaticSliders:
         if self.readout is not None:
             texts = [str(self.readout(index)) for index in itertools.product(*(range(n) for n in grid.shape))]
             readout = Div(text=texts[int(np.ravel_multi_index(grid.default_index, grid.shape))],
-                          name="kc-readout", css_classes=["kc-readout"], sizing_mode="stretch_width")
+                          name="kc-readout", css_classes=["kc-readout"], render_as_text=True,
+                          sizing_mode="stretch_width")
         callback = CustomJS(
             args={
                 "sliders": sliders,
