@@ -11,7 +11,6 @@ l'estimation recopie la mesure inversée :math:`C^{-1}y_n`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import scipy.linalg
