@@ -7,7 +7,7 @@ d'ipywidgets).
 """
 
 from .lecture import errata
-from . import figures, scenarios
+from . import figures, numbers, scenarios
 # cohérence
 from .diagnostics.consistency import (
     CentringTest,
@@ -174,6 +174,7 @@ __all__ = [
     # sous-modules
     "errata",
     "figures",
+    "numbers",
     "scenarios",
     "interactive",
 ]
