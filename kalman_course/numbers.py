@@ -263,13 +263,20 @@ def bokeh_tick_formatter():
     if (!isFinite(tick)) { return String(tick); }
     if (tick === 0) { return "0"; }
     const sup = {"-": "⁻", "0": "⁰", "1": "¹", "2": "²", "3": "³", "4": "⁴", "5": "⁵", "6": "⁶", "7": "⁷", "8": "⁸", "9": "⁹"};
-    let text = Number(tick.toPrecision(6)).toString();
-    if (text.includes("e")) {
-        const [m, e] = Number(tick).toExponential(1).split("e");
+    const french = (s) => {
+        const neg = s.startsWith("-");
+        const [int, dec] = (neg ? s.slice(1) : s).split(".");
+        const grouped = int.replace(/\B(?=(\d{3})+(?!\d))/g, "\u202f");
+        return (neg ? "\u2212" : "") + grouped + (dec ? "," + dec : "");
+    };
+    const a = Math.abs(tick);
+    if (a < 1e-3 || a >= 1e6) {
+        const [m, e] = tick.toExponential(2).split("e");
+        const mantissa = String(parseFloat(m));
         const exp = String(parseInt(e, 10)).split("").map(c => sup[c]).join("");
-        text = m + "\u202f×\u202f10" + exp;
+        return french(mantissa) + "\u202f×\u202f10" + exp;
     }
-    return text.replace(".", ",").replace(/^-/, "\u2212");
+    return french(String(Number(tick.toPrecision(6))));
     """
     return CustomJSTickFormatter(code=code)
 

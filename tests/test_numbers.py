@@ -162,3 +162,34 @@ def test_glue_number_returns_and_glues_the_french_text(monkeypatch):
     monkeypatch.setattr(myst_nb, "glue", lambda name, value, display=True: glued.update({name: (value, display)}))
     assert glue_number("p50", 3.392e-4, significant=4) == f"3,392{NN}×{NN}10⁻⁴"
     assert glued == {"p50": (f"3,392{NN}×{NN}10⁻⁴", False)}
+
+
+def test_table_cells_are_french():
+    table = kc.Table(["a", "b", "c", "d"], [[0.000339, 2.5], [1234.5, -0.5], [3, 7], ["EKF", "UKF"]],
+                     ["{:.2e}", "{:.1f} cm", None, None])
+    assert [table.cell(0, c) for c in range(4)] == [f"3,39{NN}×{NN}10⁻⁴", f"1{NN}234,5 cm", "3", "EKF"]
+    assert [table.cell(1, c) for c in range(4)] == [f"2,50{NN}×{NN}10⁰", f"{M}0,5 cm", "7", "UKF"]
+    floats = kc.Table(["x"], [[0.5, 1234.5678]])
+    assert [floats.cell(r, 0) for r in range(2)] == ["0,5", f"1{NN}234,57"]
+    assert f"3,39{NN}×{NN}10⁻⁴" in table.to_html() and "." not in table.to_markdown().replace("---:", "")
+    with pytest.raises(kc.KalmanInputError, match="champ"):
+        kc.Table(["a"], [[1.0]], ["%.3f"])
+
+
+def test_bokeh_tick_formatter_runs_in_javascript():
+    """Le code JavaScript du formateur Bokeh, exécuté par Node.js (celui de mermaid-cli)."""
+    import json
+    import shutil
+    import subprocess
+
+    from kalman_course.numbers import bokeh_tick_formatter
+
+    node = shutil.which("node")
+    if node is None:
+        pytest.fail("Node.js introuvable : il est requis pour la construction (mermaid-cli).")
+    code = bokeh_tick_formatter().code
+    ticks = [0, 0.5, -0.25, 2, 1500, 25000, 1e-5, 3.5e-7, 2.5e7, -1e-4]
+    script = f"const f = (tick) => {{ {code} }};\nconsole.log(JSON.stringify({json.dumps(ticks)}.map(f)));"
+    out = subprocess.run([node, "-e", script], capture_output=True, text=True, check=True).stdout
+    assert json.loads(out) == ["0", "0,5", f"{M}0,25", "2", f"1{NN}500", f"25{NN}000", f"1{NN}×{NN}10⁻⁵",
+                               f"3,5{NN}×{NN}10⁻⁷", f"2,5{NN}×{NN}10⁷", f"{M}1{NN}×{NN}10⁻⁴"]

@@ -39,6 +39,7 @@ from bokeh.models import (
 from bokeh.plotting import figure
 
 from ..core.validation import KalmanInputError, as_float_array
+from ..numbers import bokeh_tick_formatter
 from .grid import ParameterGrid
 from .spec import Panel, check_columns
 
@@ -136,7 +137,8 @@ class StaticSliders:
                     end=axis.values.size - 1,
                     step=1,
                     value=axis.default,
-                    title=f"{axis.symbol} — {axis.description}",
+                    # Bokeh écrit « titre: valeur » : l'espace insécable finale donne « titre : valeur »
+                    title=f"{axis.symbol} — {axis.description}\u00a0",
                     # le curseur se déplace sur les indices de la grille et affiche la vraie valeur
                     format=CustomJSTickFormatter(args={"labels": labels}, code="return labels[Math.round(tick)];"),
                     sizing_mode="stretch_width",
@@ -200,6 +202,9 @@ class StaticSliders:
             fig.toolbar.autohide = True
             fig.xaxis.axis_label = panel.x_label or self.x_label
             fig.yaxis.axis_label = panel.y_label
+            # graduations en français (virgule décimale, × 10ⁿ), sur les axes linéaires et logarithmiques
+            fig.xaxis.formatter = bokeh_tick_formatter()
+            fig.yaxis.formatter = bokeh_tick_formatter()
             items = []
             for glyph in panel.glyphs:
                 if glyph.kind == "line":
