@@ -29,7 +29,7 @@ __all__ = [
     "format_spec",
     "format_array",
     "matplotlib_formatter",
-    "french_axes",
+    "french_figure",
     "bokeh_tick_formatter",
     "glue_number",
 ]
@@ -239,19 +239,28 @@ def matplotlib_formatter():
     return FrenchScalarFormatter()
 
 
-def french_axes(figure) -> None:
-    """Graduations françaises sur tous les axes linéaires de ``figure`` (matplotlib) : chaque
-    formateur ``ScalarFormatter`` par défaut est remplacé par :func:`matplotlib_formatter` ; les
-    formateurs choisis par la figure elle-même (logarithmiques, pourcentages…) sont laissés."""
+def french_figure(figure) -> None:
+    """Une figure matplotlib à la française : graduations des axes linéaires par
+    :func:`matplotlib_formatter` (les formateurs choisis par la figure elle-même, logarithmiques ou
+    autres, sont laissés) et typographie des textes — titres, légendes, libellés, annotations — par
+    :func:`kalman_course.book_typography.french_spacing` (espaces insécables, apostrophe « ’ »,
+    formules ``$…$`` intactes)."""
+    from matplotlib.text import Text
     from matplotlib.ticker import ScalarFormatter
+
+    from .book_typography import french_spacing
 
     for ax in figure.get_axes():
         for axis in (ax.xaxis, ax.yaxis, getattr(ax, "zaxis", None)):
             if axis is None:
                 continue
-            current = axis.get_major_formatter()
-            if type(current) is ScalarFormatter:
+            if type(axis.get_major_formatter()) is ScalarFormatter:
                 axis.set_major_formatter(matplotlib_formatter())
+    for text in figure.findobj(Text):
+        old = text.get_text()
+        new = french_spacing(old)
+        if new != old:
+            text.set_text(new)
 
 
 def bokeh_tick_formatter():

@@ -213,7 +213,7 @@ def test_static_figure_html_carries_the_exact_grid(vgrid):
     assert PLOTTED_SOURCE in text
     for label in vgrid.axes[0].labels() + vgrid.axes[1].labels():
         assert label in text  # le curseur affiche les vraies valeurs
-    for words in ("itération n (sans unité)", "tension (V)", "Pₙ (V²)", "Kₙ (sans unité)", "Φ — bruit d'état"):
+    for words in ("itération n (sans unité)", "tension (V)", "Pₙ (V²)", "Kₙ (sans unité)", "Φ — bruit d’état"):
         assert words in text
 
 

@@ -16,7 +16,7 @@ from kalman_course.numbers import (
     format_number,
     format_percent,
     format_spec,
-    french_axes,
+    french_figure,
     glue_number,
     matplotlib_formatter,
 )
@@ -118,7 +118,7 @@ def test_matplotlib_axes_get_french_ticks():
     second = ax.twinx()
     second.set_yscale("log")
     second.plot([0.0, 1.0], [1e-3, 1.0])
-    french_axes(fig)
+    french_figure(fig)
     fig.savefig(io.BytesIO(), format="png")
     assert _tick_labels(ax.yaxis) == [f"{M}0,50", f"{M}0,25", "0,00", "0,25", "0,50", "0,75", "1,00", "1,25",
                                       "1,50"]

@@ -9,7 +9,7 @@ from typing import Callable
 from matplotlib.figure import Figure
 
 from ..core.validation import KalmanInputError
-from ..numbers import french_axes
+from ..numbers import french_figure
 
 __all__ = ["CourseFigure", "FigureSpec", "REGISTRY", "register", "draw", "names", "new_figure"]
 
@@ -64,8 +64,8 @@ def names() -> list[str]:
 def draw(name: str) -> Figure:
     """Construit la figure ``name`` (une nouvelle ``matplotlib.figure.Figure``, sans état global pyplot).
 
-    Les graduations des axes linéaires sont écrites en français (virgule décimale, :math:`\times 10^{n}`)
-    par :func:`kalman_course.numbers.french_axes` : une seule fois ici, pour toutes les figures."""
+    Graduations (virgule décimale, puissances de dix) et textes (espaces insécables) sont mis à la
+    française par :func:`kalman_course.numbers.french_figure` : une seule fois ici, pour toutes les figures."""
     try:
         spec = REGISTRY[name]
     except KeyError:
@@ -73,7 +73,7 @@ def draw(name: str) -> Figure:
             f"Figure inconnue « {name} ». Figures disponibles : {', '.join(REGISTRY)}."
         ) from None
     figure = spec.build()
-    french_axes(figure)
+    french_figure(figure)
     return figure
 
 

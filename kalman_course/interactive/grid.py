@@ -179,7 +179,7 @@ def precompute_grid(
             if set(out) != set(series):
                 raise KalmanInputError(
                     f"« run » doit renvoyer les mêmes séries à chaque appel : {sorted(series)} attendu, "
-                    f"{sorted(out)} reçu pour ({a:g}, {b:g})."
+                    f"{sorted(out)} reçu pour ({format_number(a, significant=6, trim=True)} ; {format_number(b, significant=6, trim=True)})."
                 )
             for name, values in out.items():
                 arr = np.asarray(values, dtype=float)

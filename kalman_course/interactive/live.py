@@ -21,7 +21,7 @@ import numpy as np
 
 from ..figures import new_figure
 from ..core.validation import KalmanInputError, as_float_array
-from ..numbers import format_spec, french_axes
+from ..numbers import format_spec, french_figure
 from .spec import Panel, check_columns
 
 __all__ = ["LogParameter", "LiveExplorer"]
@@ -53,7 +53,7 @@ class LogParameter:
         low, high = 10.0**self.min_exp, 10.0**self.max_exp
         if not (math.isfinite(v) and low <= v <= high):
             raise KalmanInputError(
-                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{low:.3g}, {high:.3g}] {self.unit}."
+                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{format_spec(low, '.3g')} ; {format_spec(high, '.3g')}] {self.unit}."
             )
 
     def slider(self) -> widgets.FloatLogSlider:
@@ -173,7 +173,7 @@ class LiveExplorer:
             ax.set_xlabel(panel.x_label or x_label)
             ax.grid(alpha=0.3, which="both" if panel.y_log else "major")
             ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
-        french_axes(fig)
+        french_figure(fig)
         return fig, lines, axes
 
     def _png(self) -> bytes:
