@@ -290,11 +290,16 @@ def bokeh_tick_formatter():
     return CustomJSTickFormatter(code=code)
 
 
-def glue_number(name: str, value: Any, **options: Any) -> str:
-    """Colle (myst-nb ``glue``, sans affichage) le nombre ``value`` écrit par :func:`format_number` sous le
-    nom ``name``, pour ``{glue:text}`name``` dans la prose ; renvoie le texte collé."""
+def glue_number(name: str, value: Any, spec: str | None = None, **options: Any) -> str:
+    """Colle (myst-nb ``glue``, sans affichage) le nombre ``value`` écrit à la française sous le nom
+    ``name``, pour ``{glue:text}`name``` (sans format) dans la prose ; renvoie le texte collé.
+
+    ``options`` : ceux de :func:`format_number` (``decimals=3``, ``significant=2``…) ; ou bien ``spec`` :
+    un format à la Python traduit par :func:`format_spec` (``spec=".1%"`` pour un pourcentage)."""
     from myst_nb import glue
 
-    text = format_number(value, **options)
+    if spec is not None and options:
+        raise KalmanInputError("Donnez « spec » ou les options de format_number, pas les deux.")
+    text = format_spec(value, spec) if spec is not None else format_number(value, **options)
     glue(name, text, display=False)
     return text

@@ -193,3 +193,14 @@ def test_bokeh_tick_formatter_runs_in_javascript():
     out = subprocess.run([node, "-e", script], capture_output=True, text=True, check=True).stdout
     assert json.loads(out) == ["0", "0,5", f"{M}0,25", "2", f"1{NN}500", f"25{NN}000", f"1{NN}×{NN}10⁻⁵",
                                f"3,5{NN}×{NN}10⁻⁷", f"2,5{NN}×{NN}10⁷", f"{M}1{NN}×{NN}10⁻⁴"]
+
+
+def test_glue_number_accepts_a_python_spec(monkeypatch):
+    import myst_nb
+
+    glued = {}
+    monkeypatch.setattr(myst_nb, "glue", lambda name, value, display=True: glued.update({name: value}))
+    assert glue_number("rel", 0.0134, spec=".1%") == f"1,3{NN}%"
+    assert glued == {"rel": f"1,3{NN}%"}
+    with pytest.raises(kc.KalmanInputError, match="pas les deux"):
+        glue_number("x", 1.0, spec=".1f", decimals=2)
