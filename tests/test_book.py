@@ -24,11 +24,13 @@ LINEAR_CHAPTERS = [
     "controle-systeme", "estimateur", "predicteur-correcteur", "gain-optimal", "tension-constante",
     "pratique-synthese",
 ]
-# Tous les chapitres du livre (hors introduction et références), tels que _toc.yml les liste.
+# Annexes : pages sans figure ni exercice.
+APPENDICES = {"references", "errata"}
+# Tous les chapitres du livre (hors introduction et annexes), tels que _toc.yml les liste.
 ALL_CHAPTERS = [
     Path(f).name
     for f in [c["file"] for part in yaml.safe_load((ROOT / "_toc.yml").read_text())["parts"] for c in part["chapters"]]
-    if Path(f).name != "references"
+    if Path(f).name not in APPENDICES
 ]
 # Seul bruit toléré dans le journal : l'avertissement d'ipykernel sur le transport TCP local des noyaux
 # (TOOLCHAIN.md : « Console noise that is not an error »).
@@ -160,3 +162,46 @@ def test_references_page_has_the_thirty_lecture_references(built_book):
     # les chapitres citent la page des références
     intro = (built_book / "book" / "intro.html").read_text()
     assert "references.html#" in intro
+
+
+# --------------------------------------------------------------------------- annexe des errata
+
+
+def _errata_labels() -> set[str]:
+    return set(re.findall(r"^\((errata-[\w-]+)\)=$", (BOOK / "errata.md").read_text(), re.M))
+
+
+def test_errata_appendix_names_existing_tests():
+    text = (BOOK / "errata.md").read_text()
+    cited = set(re.findall(r"`(test_\w+)`", text))
+    defined = set()
+    for path in (ROOT / "tests").glob("test_*.py"):
+        defined |= set(re.findall(r"^def (test_\w+)\(", path.read_text(), re.M))
+    assert cited, "l'annexe ne cite aucun test"
+    assert not cited - defined, f"tests cités mais absents : {sorted(cited - defined)}"
+
+
+def test_errata_appendix_has_the_corrections_the_chapters_did_not_cover():
+    labels = _errata_labels()
+    for number in ("000-1", "000-3", "000-11", "002-1", "002-2", "002-6", "004-5", "004-6"):
+        assert f"errata-{number}" in labels, number
+    # chaque entrée : écrit, correct, pourquoi, vérifié par
+    entries = re.split(r"^\(errata-[\w-]+\)=$", (BOOK / "errata.md").read_text(), flags=re.M)[1:]
+    assert len(entries) == len(labels)
+    for entry in entries:
+        for field in ("Écrit\n:", "Correct\n:", "Pourquoi\n:", "Vérifié par\n:"):
+            assert field in entry, entry[:80]
+
+
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
+def test_erratum_boxes_are_short_and_link_to_the_appendix(chapter):
+    text = (BOOK / f"{chapter}.md").read_text()
+    labels = _errata_labels()
+    for box in re.findall(r":::\{admonition\} Erratum[^\n]*\n:class: warning\n(.*?)\n:::", text, re.S):
+        links = re.findall(r"\{ref\}`(errata-[\w-]+)`", box)
+        assert links, f"{chapter} : encadré Erratum sans lien vers l'annexe : {box[:80]}"
+        assert set(links) <= labels, f"{chapter} : lien(s) inconnu(s) {set(links) - labels}"
+        assert len(box) < 900, f"{chapter} : encadré trop long ({len(box)} caractères) : {box[:80]}"
+    # aucun renvoi à des documents ou numéros de ligne que l'étudiant n'a pas
+    prose = re.sub(r"```\{code-cell\}.*?```", "", text, flags=re.S)
+    assert not re.search(r"\bl\.\s*\d|ALGORITHMS|\.txt\b", prose), chapter
