@@ -205,3 +205,48 @@ def test_erratum_boxes_are_short_and_link_to_the_appendix(chapter):
     # aucun renvoi à des documents ou numéros de ligne que l'étudiant n'a pas
     prose = re.sub(r"```\{code-cell\}.*?```", "", text, flags=re.S)
     assert not re.search(r"\bl\.\s*\d|ALGORITHMS|\.txt\b", prose), chapter
+
+
+# --------------------------------------------------------------------------- cellules et figures
+
+
+def _cells_with_metadata(text: str) -> list[tuple[dict, str]]:
+    """Les cellules de code : (métadonnées, source)."""
+    cells = []
+    for body in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, flags=re.S):
+        meta: dict = {}
+        if body.startswith("---\n"):
+            head, body = body[4:].split("\n---\n", 1)
+            meta = yaml.safe_load(head) or {}
+        else:
+            options = re.match(r"((?::[\w-]+:.*\n)*)", body)[1]
+            for key, value in re.findall(r"^:([\w-]+):\s*(.*)$", options, re.M):
+                meta[key] = yaml.safe_load(value)
+            body = body[len(options):]
+        cells.append((meta, body))
+    return cells
+
+
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
+def test_every_figure_has_a_caption_a_name_and_an_alt_text(chapter):
+    for meta, body in _cells_with_metadata((BOOK / f"{chapter}.md").read_text()):
+        drawn = re.findall(r'kc\.figures\.draw\("([^"]+)"\)', body)
+        if not drawn:
+            continue
+        figure = meta.get("mystnb", {}).get("figure", {})
+        alt = meta.get("mystnb", {}).get("image", {}).get("alt", "")
+        assert len(figure.get("caption", "")) > 20, f"{chapter} : {drawn[0]} sans légende"
+        assert figure.get("name") == f"fig-{drawn[0]}", f"{chapter} : {drawn[0]} sans nom de figure"
+        assert len(alt) > 40, f"{chapter} : {drawn[0]} sans texte de remplacement"
+
+
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
+def test_bookkeeping_cells_are_hidden(chapter):
+    """Une cellule qui colle des nombres, ou qui ne fait qu'importer, est cachée aux étudiants."""
+    for meta, body in _cells_with_metadata((BOOK / f"{chapter}.md").read_text()):
+        tags = set(meta.get("tags", []))
+        code = [line for line in body.splitlines() if line.strip() and not line.lstrip().startswith("#")]
+        glues = re.search(r"(^|[^\w.])glue\(|glue_number\(", body)
+        imports_only = code and all(re.match(r"(import|from)\s", line) for line in code)
+        if glues or imports_only:
+            assert tags & {"remove-cell", "remove-input"}, f"{chapter} : cellule visible :\n{body[:200]}"
