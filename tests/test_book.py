@@ -250,3 +250,9 @@ def test_bookkeeping_cells_are_hidden(chapter):
         imports_only = code and all(re.match(r"(import|from)\s", line) for line in code)
         if glues or imports_only:
             assert tags & {"remove-cell", "remove-input"}, f"{chapter} : cellule visible :\n{body[:200]}"
+
+
+def test_errata_headings_have_no_math():
+    """Un titre d'entrée sert de texte aux liens {ref} des chapitres, rendu sans MathJax : pas de $…$."""
+    headings = re.findall(r"^### (.*)$", (BOOK / "errata.md").read_text(), re.M)
+    assert headings and not [h for h in headings if "$" in h or "\\" in h]
