@@ -9,7 +9,6 @@ from typing import Any, Sequence
 import numpy as np
 
 from .core.validation import KalmanInputError
-from .numbers import format_integer, format_spec
 
 __all__ = ["Table"]
 
@@ -71,6 +70,8 @@ class Table:
 
     def cell(self, row: int, col: int) -> str:
         """Texte de la case (ligne ``row``, colonne ``col``)."""
+        from .numbers import format_integer, format_spec  # Babel, chargé à l'affichage seulement
+
         value = self.columns[col][row]
         fmt = self.formats[col]
         if isinstance(value, str) or value is None:

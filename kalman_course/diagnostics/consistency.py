@@ -28,7 +28,6 @@ import scipy.linalg
 import scipy.stats
 
 from ..filters.kalman import kalman_filter
-from ..numbers import format_spec as fr
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult, freeze, freeze_fields
 from ..core.simulation import as_generator, simulate
@@ -248,6 +247,8 @@ class ChiSquareTest:
     consistent: bool
 
     def __str__(self) -> str:
+        from ..numbers import format_spec as fr  # Babel, chargé à l'affichage seulement
+
         verdict = "cohérent" if self.consistent else "incohérent : hypothèse rejetée"
         return (
             f"Test du χ² sur la {self.quantity} moyenne ({self.n_values} valeur(s))\n"
@@ -416,6 +417,8 @@ class WhitenessTest:
         freeze_fields(self, "autocorrelation", "ljung_box", "component_p_values")
 
     def __str__(self) -> str:
+        from ..numbers import format_spec as fr  # Babel, chargé à l'affichage seulement
+
         verdict = "blanches" if self.white else "non blanches : hypothèse rejetée"
         return (
             f"Test de blancheur ({self.n_values} innovations, décalages 1 à {self.lags[-1]})\n"
@@ -500,6 +503,8 @@ class CentringTest:
         freeze_fields(self, "mean", "t_statistic", "t_p_values")
 
     def __str__(self) -> str:
+        from ..numbers import format_spec as fr  # Babel, chargé à l'affichage seulement
+
         verdict = "centrées" if self.centred else "non centrées : hypothèse rejetée"
         means = " ; ".join(fr(v, ".3g") for v in self.mean)  # « ; » : la virgule est décimale
         return (

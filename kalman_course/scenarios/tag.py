@@ -25,7 +25,6 @@ from ..filters.extended import extended_kalman_filter
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, freeze_fields
 from ..core.simulation import as_generator
-from ..numbers import format_spec
 from ..tables import Table
 from ..core.validation import KalmanInputError, shape_text
 from ._motion import cv_process_noise, cv_transition
@@ -220,6 +219,8 @@ def rmse_grid(accel_stds: Any, range_stds: Any, data: TagData | None = None) -> 
 def rmse_table(accel_stds: Any, range_stds: Any, data: TagData | None = None) -> Table:
     r""":func:`rmse_grid` en tableau (centimètres) : une ligne par :math:`\sigma_a`, une colonne par :math:`\sigma_r`."""
     grid = 100 * rmse_grid(accel_stds, range_stds, data)
+    from ..numbers import format_spec  # Babel, chargé à l'affichage seulement
+
     headers = [r"$\sigma_a$ (m/s²) ↓ · $\sigma_r$ (m) →"] + [format_spec(r, "g") for r in range_stds]
     columns = [[format_spec(q, "g") for q in accel_stds]] + [grid[:, j] for j in range(grid.shape[1])]
     return Table(headers, columns, [None] + ["{:.1f}"] * grid.shape[1])
