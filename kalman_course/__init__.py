@@ -179,9 +179,9 @@ __all__ = [
     # sous-modules
     "errata",
     "figures",
+    "numbers",
     "scenarios",
     "interactive",
-    "numbers",
 ]
 
 __version__ = "0.1.0"

@@ -162,15 +162,15 @@ def test_precompute_grid_is_generic():
 @pytest.mark.parametrize(
     "value, unit, text",
     [
-        (1e-5, "V²", "1·10⁻⁵ V²"),
-        (10**-4.5, "V²", "3,16·10⁻⁵ V²"),
-        (0.01, "V²", "0,01 V²"),
-        (0.0316227766, "V²", "0,0316 V²"),
-        (1.0, "V²", "1 V²"),
-        (100.0, "V²", "100 V²"),
-        (9.9999e-5, "", "1·10⁻⁴"),
-        (2.5e4, "m", "2,5·10⁴ m"),
-        (0.5, "m/s²", "0,5 m/s²"),
+        (1e-5, "V²", "1\u202f×\u202f10⁻⁵\u00a0V²"),
+        (10**-4.5, "V²", "3,16\u202f×\u202f10⁻⁵\u00a0V²"),
+        (0.01, "V²", "0,01\u00a0V²"),
+        (0.0316227766, "V²", "0,0316\u00a0V²"),
+        (1.0, "V²", "1\u00a0V²"),
+        (100.0, "V²", "100\u00a0V²"),
+        (9.9999e-5, "", "1\u202f×\u202f10⁻⁴"),
+        (2.5e4, "m", "2,5\u202f×\u202f10⁴\u00a0m"),
+        (0.5, "m/s²", "0,5\u00a0m/s²"),
     ],
 )
 def test_format_value_writes_real_values_in_french(value, unit, text):
@@ -215,7 +215,7 @@ def test_static_figure_html_carries_the_exact_grid(vgrid):
     assert PLOTTED_SOURCE in text
     for label in vgrid.axes[0].labels() + vgrid.axes[1].labels():
         assert label in text  # le curseur affiche les vraies valeurs
-    for words in ("itération n (sans unité)", "tension (V)", "Pₙ (V²)", "Kₙ (sans unité)", "Φ — bruit d'état"):
+    for words in ("itération n (sans unité)", "tension (V)", "Pₙ (V²)", "Kₙ (sans unité)", "Φ — bruit d’état"):
         assert words in text
 
 

@@ -9,6 +9,7 @@ from typing import Callable
 from matplotlib.figure import Figure
 
 from ..core.validation import KalmanInputError
+from ..numbers import french_figure
 
 __all__ = ["CourseFigure", "FigureSpec", "REGISTRY", "register", "draw", "names", "new_figure"]
 
@@ -61,14 +62,19 @@ def names() -> list[str]:
 
 
 def draw(name: str) -> Figure:
-    """Construit la figure ``name`` (une nouvelle ``matplotlib.figure.Figure``, sans état global pyplot)."""
+    """Construit la figure ``name`` (une nouvelle ``matplotlib.figure.Figure``, sans état global pyplot).
+
+    Graduations (virgule décimale, puissances de dix) et textes (espaces insécables) sont mis à la
+    française par :func:`kalman_course.numbers.french_figure` : une seule fois ici, pour toutes les figures."""
     try:
         spec = REGISTRY[name]
     except KeyError:
         raise KalmanInputError(
             f"Figure inconnue « {name} ». Figures disponibles : {', '.join(REGISTRY)}."
         ) from None
-    return spec.build()
+    figure = spec.build()
+    french_figure(figure)
+    return figure
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 7.0, height: float = 3.6, **kwargs):

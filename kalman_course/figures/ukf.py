@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..scenarios.tag import TAG_TRANSIENT_STEPS, position_rmse, run_tag_ekf, run_tag_ukf, tag_data
+from ..numbers import format_spec as fr
 from ._registry import new_figure, register
 
 CHAPTER = "pour-aller-plus-loin"
@@ -20,9 +21,9 @@ def ukf_comparison():
     gap = np.linalg.norm(ekf.x[:, :2] - ukf.x[:, :2], axis=1)
     fig, (ax, ad) = new_figure(2, 1, width=7.5, height=5.2, sharex=True)
     ax.plot(data.t, 100 * e_ekf, color="tab:blue", lw=1.4,
-            label=f"EKF (erreur quadratique moyenne {100 * position_rmse(ekf.x, data.x_true):.2f} cm)")
+            label=f"EKF (erreur quadratique moyenne {fr(100 * position_rmse(ekf.x, data.x_true), '.2f')} cm)")
     ax.plot(data.t, 100 * e_ukf, color="tab:orange", lw=1.0, ls="--",
-            label=f"UKF (erreur quadratique moyenne {100 * position_rmse(ukf.x, data.x_true):.2f} cm)")
+            label=f"UKF (erreur quadratique moyenne {fr(100 * position_rmse(ukf.x, data.x_true), '.2f')} cm)")
     ax.axvspan(0, data.t[TAG_TRANSIENT_STEPS - 1], color="0.85", label="régime transitoire (exclu)")
     ax.set_ylim(0, 30)
     ax.set_ylabel(r"erreur de position $\|\hat p - p\|$ (cm)")

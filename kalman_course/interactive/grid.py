@@ -19,32 +19,19 @@ import numpy as np
 
 from ..core.results import freeze
 from ..core.validation import KalmanInputError, as_float_array, shape_text
+from ..numbers import format_number
 
 __all__ = ["ParameterAxis", "ParameterGrid", "log_grid", "precompute_grid", "format_value"]
 
-_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
-
-
 def format_value(value: float, unit: str = "") -> str:
-    r"""Écriture française d'une valeur de paramètre : ``0,01 V²``, ``3,16·10⁻⁵ V²``, ``1·10⁻⁹ V²``.
+    r"""Écriture française d'une valeur de paramètre : « 0,01 V² », « 3,16 × 10⁻⁵ V² », « 1 × 10⁻⁹ V² ».
 
-    Trois chiffres significatifs, virgule décimale ; notation scientifique hors de
-    :math:`[10^{-2}, 10^{3})`.
+    Trois chiffres significatifs (zéros finals retirés), par :func:`kalman_course.numbers.format_number` ;
+    écriture :math:`m \times 10^{n}` hors de :math:`[10^{-2}, 10^{3})` ; unité après une espace insécable.
     """
     v = float(value)
-    if v == 0.0:
-        text = "0"
-    elif 1e-2 <= abs(v) < 1e3:
-        text = f"{v:.3g}".replace(".", ",")
-    else:
-        exponent = math.floor(math.log10(abs(v)))
-        mantissa = v / 10.0**exponent
-        if round(abs(mantissa), 2) >= 10.0:  # 9,996·10⁻⁵ arrondi → 1·10⁻⁴
-            mantissa /= 10.0
-            exponent += 1
-        m_text = f"{mantissa:.3g}".replace(".", ",")
-        text = f"{m_text}·10{str(exponent).translate(_SUPERSCRIPT)}"
-    return f"{text} {unit}".strip()
+    scientific = v != 0.0 and not 1e-2 <= abs(v) < 1e3
+    return format_number(v, significant=3, trim=True, scientific=scientific, unit=unit or None)
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,7 +179,7 @@ def precompute_grid(
             if set(out) != set(series):
                 raise KalmanInputError(
                     f"« run » doit renvoyer les mêmes séries à chaque appel : {sorted(series)} attendu, "
-                    f"{sorted(out)} reçu pour ({a:g}, {b:g})."
+                    f"{sorted(out)} reçu pour ({format_number(a, significant=6, trim=True)} ; {format_number(b, significant=6, trim=True)})."
                 )
             for name, values in out.items():
                 arr = np.asarray(values, dtype=float)

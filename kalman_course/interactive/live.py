@@ -21,6 +21,7 @@ import numpy as np
 
 from ..figures import new_figure
 from ..core.validation import KalmanInputError, as_float_array
+from ..numbers import format_spec, french_figure
 from .spec import Panel, check_columns
 
 __all__ = ["LogParameter", "LiveExplorer"]
@@ -52,7 +53,7 @@ class LogParameter:
         low, high = 10.0**self.min_exp, 10.0**self.max_exp
         if not (math.isfinite(v) and low <= v <= high):
             raise KalmanInputError(
-                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{low:.3g}, {high:.3g}] {self.unit}."
+                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{format_spec(low, '.3g')} ; {format_spec(high, '.3g')}] {self.unit}."
             )
 
     def slider(self) -> widgets.FloatLogSlider:
@@ -172,6 +173,7 @@ class LiveExplorer:
             ax.set_xlabel(panel.x_label or x_label)
             ax.grid(alpha=0.3, which="both" if panel.y_log else "major")
             ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
+        french_figure(fig)
         return fig, lines, axes
 
     def _png(self) -> bytes:
@@ -202,5 +204,5 @@ class LiveExplorer:
         return self.widget._repr_mimebundle_(**kwargs)
 
     def __repr__(self) -> str:
-        values = ", ".join(f"{k} = {v:.3g}" for k, v in self.values().items())
+        values = " ; ".join(f"{k} = {format_spec(v, '.3g')}" for k, v in self.values().items())
         return f"<Curseurs vivants ({values}) : exige un noyau Jupyter en marche>"

@@ -39,6 +39,8 @@ from bokeh.models import (
 from bokeh.plotting import figure
 
 from ..core.validation import KalmanInputError, as_float_array
+from ..book_typography import french_spacing
+from ..numbers import bokeh_tick_formatter
 from .grid import ParameterGrid
 from .spec import Panel, check_columns
 
@@ -136,7 +138,8 @@ class StaticSliders:
                     end=axis.values.size - 1,
                     step=1,
                     value=axis.default,
-                    title=f"{axis.symbol} — {axis.description}",
+                    # Bokeh écrit « titre: valeur » : l'espace insécable finale donne « titre : valeur »
+                    title=french_spacing(f"{axis.symbol} — {axis.description}") + "\u00a0",
                     # le curseur se déplace sur les indices de la grille et affiche la vraie valeur
                     format=CustomJSTickFormatter(args={"labels": labels}, code="return labels[Math.round(tick)];"),
                     sizing_mode="stretch_width",
@@ -188,7 +191,7 @@ class StaticSliders:
                 (x0, x1), (y0, y1) = panel.x_range, y_range
                 size = {"aspect_ratio": (x1 - x0) / (y1 - y0), "sizing_mode": "scale_width"}
             fig = figure(
-                title=panel.title,
+                title=french_spacing(panel.title),
                 tools="pan,box_zoom,wheel_zoom,reset,save",
                 toolbar_location="right",
                 x_range=Range1d(*panel.x_range) if panel.own_x else time_range,
@@ -198,8 +201,11 @@ class StaticSliders:
             )
             fig.toolbar.logo = None  # pas de lien sortant vers bokeh.org
             fig.toolbar.autohide = True
-            fig.xaxis.axis_label = panel.x_label or self.x_label
-            fig.yaxis.axis_label = panel.y_label
+            fig.xaxis.axis_label = french_spacing(panel.x_label or self.x_label)
+            fig.yaxis.axis_label = french_spacing(panel.y_label)
+            # graduations en français (virgule décimale, × 10ⁿ), sur les axes linéaires et logarithmiques
+            fig.xaxis.formatter = bokeh_tick_formatter()
+            fig.yaxis.formatter = bokeh_tick_formatter()
             items = []
             for glyph in panel.glyphs:
                 if glyph.kind == "line":
@@ -209,7 +215,7 @@ class StaticSliders:
                 else:
                     x0, x1 = panel.x_range if panel.own_x else (float(grid.time[0]), float(grid.time[-1]))
                     r = fig.line([x0, x1], [glyph.value, glyph.value], color=glyph.color, line_width=1.5)
-                items.append(LegendItem(label=glyph.legend, renderers=[r]))
+                items.append(LegendItem(label=french_spacing(glyph.legend), renderers=[r]))
             # légende au-dessus du tracé : elle ne cache jamais les courbes
             fig.add_layout(
                 Legend(items=items, orientation="horizontal", location="top_left", label_text_font_size="9pt",
@@ -233,7 +239,7 @@ class StaticSliders:
         )
         s0.js_on_change("value", callback)
         s1.js_on_change("value", callback)
-        header = [Div(text=f"<strong>{html.escape(self.title)}</strong>")] if self.title else []
+        header = [Div(text=f"<strong>{html.escape(french_spacing(self.title))}</strong>")] if self.title else []
         return column(*header, row(s0, s1, sizing_mode="stretch_width"), *figures, sizing_mode="stretch_width")
 
     # ------------------------------------------------------------------ sortie HTML

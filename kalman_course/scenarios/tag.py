@@ -230,6 +230,8 @@ def rmse_grid(accel_stds: Any, range_stds: Any, data: TagData | None = None) -> 
 def rmse_table(accel_stds: Any, range_stds: Any, data: TagData | None = None) -> Table:
     r""":func:`rmse_grid` en tableau (centimètres) : une ligne par :math:`\sigma_a`, une colonne par :math:`\sigma_r`."""
     grid = 100 * rmse_grid(accel_stds, range_stds, data)
-    headers = [r"$\sigma_a$ (m/s²) ↓ · $\sigma_r$ (m) →"] + [f"{r:g}" for r in range_stds]
-    columns = [[f"{q:g}" for q in accel_stds]] + [grid[:, j] for j in range(grid.shape[1])]
+    from ..numbers import format_spec  # Babel, chargé à l'affichage seulement
+
+    headers = [r"$\sigma_a$ (m/s²) ↓ · $\sigma_r$ (m) →"] + [format_spec(r, "g") for r in range_stds]
+    columns = [[format_spec(q, "g") for q in accel_stds]] + [grid[:, j] for j in range(grid.shape[1])]
     return Table(headers, columns, [None] + ["{:.1f}"] * grid.shape[1])
