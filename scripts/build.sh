@@ -27,9 +27,9 @@ echo "Site construit : $(pwd)/_build/html/index.html"
 
 if [ "$pdf" = 1 ]; then
   start=$(date +%s)
-  # même cache d'exécution que le site : aucun carnet n'est relancé
-  .venv/bin/jupyter-book build . --builder pdflatex --all -W --keep-going ${args[@]+"${args[@]}"}
-  mkdir -p _build/pdf
-  cp _build/latex/filtre-de-kalman.pdf _build/pdf/filtre-de-kalman.pdf
+  # Même cache d'exécution et même environnement Sphinx que le site, qu'on vient de reconstruire en
+  # entier : aucun carnet n'est relancé, aucune page relue.
+  .venv/bin/jupyter-book build . --builder latex -W --keep-going ${args[@]+"${args[@]}"}
+  .venv/bin/python scripts/pdf.py _build/latex _build/pdf/filtre-de-kalman.pdf
   echo "PDF construit en $(( $(date +%s) - start )) s : $(pwd)/_build/pdf/filtre-de-kalman.pdf"
 fi
