@@ -25,7 +25,7 @@ done
 # Pythons pris en charge : ceux sur lesquels requirements.txt s'installe et les tests passent.
 SUPPORTED_TEXT="3.11 (dès 3.11.2, celui de Debian 12) et 3.12 (celui d'Ubuntu 24.04)"
 python_version() { "$1" -c 'import sys; print("%d.%d.%d" % sys.version_info[:3])' 2>/dev/null; }
-is_supported() { case "$1" in 3.11.*|3.12.*) return 0 ;; *) return 1 ;; esac; }
+is_supported() { case "$1" in 3.11.0|3.11.1) return 1 ;; 3.11.*|3.12.*) return 0 ;; *) return 1 ;; esac; }
 
 apt_install() {
   # apt_install RAISON PAQUET… : installe des paquets Debian si l'on est root, sinon explique quoi faire.
@@ -63,6 +63,11 @@ if [ "$want_pdf" = 1 ] && ! tex_ready; then
 fi
 
 # --- Python -------------------------------------------------------------------------------------
+# PYTHON donné : ce Python (un .venv fait avec un autre est refait). Sinon : le .venv existant s'il est
+# d'un Python pris en charge, ou le premier Python pris en charge trouvé.
+base_of() { "$1" -c 'import os, sys; print(os.path.realpath(sys._base_executable))' 2>/dev/null || echo "?"; }
+venv_v=""
+[ -x .venv/bin/python ] && venv_v=$(python_version .venv/bin/python || echo "?")
 if [ -n "${PYTHON:-}" ]; then
   PYTHON_BIN=$PYTHON
   v=$(python_version "$PYTHON_BIN") || { log "ERREUR : PYTHON=$PYTHON n'est pas un interpréteur Python utilisable."; exit 1; }
@@ -70,6 +75,12 @@ if [ -n "${PYTHON:-}" ]; then
     log "ERREUR : PYTHON=$PYTHON est Python $v. Pythons pris en charge : $SUPPORTED_TEXT."
     exit 1
   fi
+  if [ -n "$venv_v" ] && [ "$(base_of .venv/bin/python)" != "$(base_of "$PYTHON_BIN")" ]; then
+    log ".venv utilise Python $venv_v ($(base_of .venv/bin/python)) ; on le refait avec PYTHON=$PYTHON ($v)"
+    rm -rf .venv
+  fi
+elif [ -n "$venv_v" ] && is_supported "$venv_v"; then
+  PYTHON_BIN=$(base_of .venv/bin/python)
 else
   PYTHON_BIN=""
   seen=""
@@ -85,20 +96,14 @@ else
     log "         Installez-en un, ou indiquez-le : PYTHON=/chemin/vers/python3.12 bash scripts/setup.sh"
     exit 1
   fi
-  v=$(python_version "$PYTHON_BIN")
-fi
-
-# Un .venv fait avec un autre Python (autre version, ou PYTHON imposé) est refait.
-if [ -x .venv/bin/python ]; then
-  venv_v=$(python_version .venv/bin/python || echo "?")
-  venv_base=$(.venv/bin/python -c 'import sys; print(sys._base_executable)' 2>/dev/null || echo "?")
-  want_base=$("$PYTHON_BIN" -c 'import sys; print(sys._base_executable)')
-  if ! is_supported "$venv_v" || [ "$venv_v" != "$v" ] || { [ -n "${PYTHON:-}" ] && [ "$venv_base" != "$want_base" ]; }; then
-    log ".venv utilise Python $venv_v ($venv_base) ; on le refait avec Python $v ($PYTHON_BIN)"
+  [ -n "$seen" ] && log "non pris en charge :$seen ; Pythons pris en charge : $SUPPORTED_TEXT."
+  if [ -n "$venv_v" ]; then
+    log ".venv utilise Python $venv_v, non pris en charge ; on le refait"
     rm -rf .venv
   fi
 fi
 if [ ! -x .venv/bin/python ]; then
+  v=$(python_version "$PYTHON_BIN")
   log "création de l'environnement virtuel .venv (Python $v, $PYTHON_BIN)"
   if ! "$PYTHON_BIN" -m venv .venv; then
     rm -rf .venv
@@ -106,6 +111,7 @@ if [ ! -x .venv/bin/python ]; then
     exit 1
   fi
 fi
+v=$(python_version .venv/bin/python)
 stamp=.venv/.requirements.sha
 want=$( (cat requirements.txt pyproject.toml; echo "$v") | sha256sum | cut -d' ' -f1)
 pip_quiet() {
