@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import filecmp
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -22,21 +23,32 @@ import kalman_course as kc
 TARGET_S = 15.0
 
 
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def timed_command(out: Path, *args: str) -> float:
+    """Durée (s) de la commande ; imprime aussi son temps CPU (processus fils compris) et la charge de
+    la machine : sur une machine partagée et chargée, le temps écoulé n'est pas la mesure du code."""
+    cpu = _children_cpu()
     start = time.perf_counter()
     subprocess.run([sys.executable, "-m", "kalman_course.figures", "--out", str(out), *args],
                    check=True, capture_output=True)
-    return time.perf_counter() - start
+    elapsed = time.perf_counter() - start
+    print(f"  {' '.join(args)} : {elapsed:.1f} s écoulées, {_children_cpu() - cpu:.1f} s CPU, "
+          f"charge moyenne {os.getloadavg()[0]:.1f} sur {os.cpu_count()} cœurs")
+    return elapsed
 
 
 def main() -> None:
     total = 0.0
     for name in kc.figures.names():
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         kc.figures.draw(name)
         elapsed = time.perf_counter() - start
         total += elapsed
-        print(f"{name:32s} {elapsed:6.2f} s")
+        print(f"{name:32s} {elapsed:6.2f} s ({time.process_time() - cpu:5.2f} s CPU)")
     n = len(kc.figures.names())
     print(f"{'calcul et tracé (sans écriture)':32s} {total:6.2f} s")
     cores = os.cpu_count() or 1
