@@ -15,6 +15,9 @@ import pytest
 import yaml
 
 import kalman_course as kc
+from kalman_course.figures._registry import CHAPTER_TITLES
+
+from conftest import ROOT as REPO_ROOT, tree_state
 
 ROOT = Path(__file__).resolve().parent.parent
 BOOK = ROOT / "book"
@@ -32,9 +35,9 @@ ALL_CHAPTERS = [
     for f in [c["file"] for part in yaml.safe_load((ROOT / "_toc.yml").read_text())["parts"] for c in part["chapters"]]
     if Path(f).name not in APPENDICES
 ]
-# Seul bruit toléré dans le journal : l'avertissement d'ipykernel sur le transport TCP local des noyaux
-# (TOOLCHAIN.md : « Console noise that is not an error »).
-TOLERATED = re.compile(r"\[IPKernelApp\] WARNING \| Kernel is running over TCP without encryption")
+# Aucun avertissement n'est toléré dans le journal. (L'avis d'ipykernel « Kernel is running over TCP
+# without encryption », émis par chaque noyau qui parle en TCP local à la construction, est retiré à la
+# source par scripts/ipython_kernel_config.py, que scripts/setup.sh installe dans .venv.)
 
 
 def _toc_files() -> list[str]:
@@ -85,15 +88,32 @@ def test_each_chapter_has_an_exercise_with_a_hidden_computed_solution(chapter):
         assert "kc." in "".join(_code_cells(block.group(1) + "```")), f"{label} : la solution n'appelle pas le paquet"
 
 
+def test_figure_registry_knows_every_chapter_title():
+    """``python -m kalman_course.figures --list`` cite le chapitre de chaque figure par son titre : ces
+    titres (kalman_course/figures/_registry.py) doivent être ceux des chapitres du livre."""
+    for chapter in sorted({spec.chapter for spec in kc.figures.REGISTRY.values()}):
+        heading = re.search(r"(?m)^# (.+)$", (BOOK / f"{chapter}.md").read_text()).group(1).strip()
+        assert CHAPTER_TITLES.get(chapter) == heading, (
+            f"{chapter} : titre « {heading} » absent de CHAPTER_TITLES ou différent"
+        )
+
+
 # --------------------------------------------------------------------------- construction
 
 
 @pytest.mark.book
 def test_build_log_has_no_warning(built_book):
     log = (built_book.parent / "build.log").read_text()
-    warnings = [line for line in log.splitlines() if "WARNING" in line and not TOLERATED.search(line)]
+    warnings = [line for line in log.splitlines() if "WARNING" in line]
     assert not warnings, "\n".join(warnings)
     assert "build succeeded" in log
+
+
+@pytest.mark.book
+def test_build_leaves_the_user_build_untouched(built_book, user_build_before):
+    """Les tests construisent ailleurs (dossier temporaire) : _build/ du dépôt est intact."""
+    assert not built_book.is_relative_to(REPO_ROOT / "_build")
+    assert tree_state(REPO_ROOT / "_build") == user_build_before
 
 
 @pytest.mark.book

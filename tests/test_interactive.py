@@ -392,3 +392,24 @@ def test_bad_grid_and_figure_arguments():
         ki.StaticSliders(grid, (panel,), "t (s)", fixed={"t": t})
     with pytest.raises(kc.KalmanInputError, match="min_exp"):
         ki.LogParameter("Q", "Φ", "V²", 1e-3, 0.0, -2.0)
+
+
+def test_static_sliders_print_the_default_run_with_a_caption():
+    """Le PDF n'anime pas de curseurs : la figure fournit un PNG (position par défaut) et une légende.
+    Le PNG trace l'exécution que donne un appel direct du filtre (voltage_run), pas la grille."""
+    from kalman_course.interactive.static import CAPTION_ATTRIBUTE
+    from kalman_course.interactive.voltage import VOLTAGE_Q, VOLTAGE_R
+
+    figure = kc.interactive.voltage_sliders()
+    data, metadata = figure._repr_mimebundle_()
+    assert data["image/png"][:8] == b"\x89PNG\r\n\x1a\n"
+    assert metadata["image/png"]["width"] > 0 and metadata["image/png"]["height"] > 0
+    assert f'{CAPTION_ATTRIBUTE}="' in data["text/html"]
+    expected = kc.interactive.voltage_run(VOLTAGE_Q, VOLTAGE_R)
+    plotted = {line.get_label(): np.asarray(line.get_ydata()) for ax in figure.default_figure().axes
+               for line in ax.get_lines()}
+    np.testing.assert_allclose(plotted["estimation x̂ₙ"], expected["x"], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(plotted["Pₙ (a posteriori)"], expected["P"], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(plotted["gain Kₙ"], expected["K"], rtol=0, atol=1e-15)
+    caption = figure.caption()
+    assert "Φ = 1·10⁻⁵ V²" in caption and "Ψ = 0,01 V²" in caption and "15 × 15" in caption

@@ -11,7 +11,25 @@ from matplotlib.figure import Figure
 from ..core.validation import KalmanInputError
 from ..numbers import french_figure
 
-__all__ = ["CourseFigure", "FigureSpec", "REGISTRY", "register", "draw", "names", "new_figure"]
+__all__ = ["CHAPTER_TITLES", "CourseFigure", "FigureSpec", "REGISTRY", "register", "draw", "names", "new_figure"]
+
+#: Titre de chaque chapitre (nom du fichier ``book/<nom>.md`` → titre de niveau 1), pour
+#: ``python -m kalman_course.figures --list`` ; ``tests/test_book.py`` vérifie qu'ils suivent le livre.
+CHAPTER_TITLES: dict[str, str] = {
+    "controle-systeme": "Contrôle d'un système dynamique",
+    "estimateur": "Construction d'un estimateur",
+    "predicteur-correcteur": "Le filtre prédicteur–correcteur",
+    "gain-optimal": "Dynamique de l'erreur et gain optimal",
+    "tension-constante": "Exemple — estimation d'une tension constante",
+    "pratique-synthese": "Implémentation pratique et synthèse",
+    "tests-statistiques": "Vérifier les hypothèses : tests statistiques",
+    "ekf": "Dynamique non linéaire — le filtre de Kalman étendu",
+    "suivi-tag": "Exemple — suivi d'un tag radio (UWB)",
+    "ekf-itere": "Filtre de Kalman étendu itéré",
+    "pour-aller-plus-loin": "Pour aller plus loin : le filtre de Kalman « unscented »",
+    "srif": "Filtre d'information en racine carrée (SRIF)",
+    "ekf-itere-se3": "EKF itéré sur SE(3) : pose d'une cible vue par une caméra",
+}
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).
 DISPLAY_DPI = 144
@@ -39,6 +57,17 @@ class FigureSpec:
     chapter: str
     title: str
     build: Callable[[], Figure]
+
+    @property
+    def description(self) -> str:
+        """Ce que montre la figure, en français (son titre dans le registre)."""
+        return self.title
+
+    @property
+    def chapter_title(self) -> str:
+        """Titre du chapitre qui montre la figure (le nom de fichier s'il n'est pas dans
+        :data:`CHAPTER_TITLES`)."""
+        return CHAPTER_TITLES.get(self.chapter, self.chapter)
 
 
 REGISTRY: dict[str, FigureSpec] = {}

@@ -19,10 +19,9 @@ from typing import Callable, Mapping
 import ipywidgets as widgets
 import numpy as np
 
-from ..figures import new_figure
 from ..core.validation import KalmanInputError, as_float_array
-from ..numbers import format_spec, french_figure
-from .spec import Panel, check_columns
+from ..numbers import format_spec
+from .spec import Panel, check_columns, draw_panels
 
 __all__ = ["LogParameter", "LiveExplorer"]
 
@@ -143,37 +142,13 @@ class LiveExplorer:
         return series
 
     def _draw(self, x_label: str):
-        height = sum(p.height for p in self.panels) / 80.0
-        shared = not any(p.own_x for p in self.panels)
-        fig, axes = new_figure(len(self.panels), 1, width=7.0, height=height, sharex=shared, squeeze=False)
-        axes = axes[:, 0]
-        lines: dict[str, list] = {}
         data = {"t": self.time, **self.fixed, **self.series}
-        for ax, panel in zip(axes, self.panels):
-            for glyph in panel.glyphs:
-                x = glyph.x
-                if glyph.kind == "hline":
-                    ax.axhline(glyph.value, color=glyph.color, lw=1.5, label=glyph.legend)
-                    continue
-                style = {"marker": "+", "ls": "none", "ms": 7} if glyph.kind == "scatter" else {"lw": 1.8}
-                (line,) = ax.plot(data[x], data[glyph.column], color=glyph.color, label=glyph.legend, **style)
-                line.kc_columns = (x, glyph.column)  # séries (abscisse, ordonnée) à relire au redessin
-                if glyph.column in self.series or x in self.series:
-                    lines.setdefault(glyph.column, []).append(line)
-            if panel.y_log:
-                ax.set_yscale("log")
-            if panel.y_range is not None:
-                ax.set_ylim(*panel.y_range)
-            if panel.x_range is not None:
-                ax.set_xlim(*panel.x_range)
-            if panel.equal_aspect:
-                ax.set_aspect("equal")
-            ax.set_title(panel.title, fontsize=10)
-            ax.set_ylabel(panel.y_label)
-            ax.set_xlabel(panel.x_label or x_label)
-            ax.grid(alpha=0.3, which="both" if panel.y_log else "major")
-            ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
-        french_figure(fig)
+        fig, drawn, axes = draw_panels(self.panels, data, x_label)
+        lines: dict[str, list] = {}  # seules les courbes qui dépendent des curseurs sont redessinées
+        for column, found in drawn.items():
+            moving = [line for line in found if column in self.series or line.kc_columns[0] in self.series]
+            if moving:
+                lines[column] = moving
         return fig, lines, axes
 
     def _png(self) -> bytes:

@@ -90,3 +90,56 @@ def check_columns(panels, known: set[str]) -> None:
                     f"Le tracé « {glyph.legend} » lit la série « {glyph.column} », absente des séries "
                     f"calculées et fixes ({', '.join(sorted(known))})."
                 )
+
+
+def draw_panels(panels, data, x_label: str, *, height_px_per_inch: float = 80.0):
+    """Dessine les panneaux avec matplotlib (sans pyplot), un sous-graphique par panneau.
+
+    Sert aux curseurs vivants (:mod:`.live`, figure redessinée à chaque mouvement) et à l'image fixe
+    des curseurs statiques (:mod:`.static`, figure du PDF à la position par défaut des curseurs).
+
+    Paramètres
+    ----------
+    panels : suite de Panel
+    data : dict nom → (T,)
+        Toutes les séries lues par les tracés, dont ``"t"`` (le temps commun).
+    x_label : str
+        Libellé de l'abscisse commune, avec unité.
+
+    Renvoie ``(fig, lines, axes)`` : la figure, ``lines`` (dict nom de série → liste de ``Line2D``
+    tracées ; chaque ligne porte ``kc_columns = (abscisse, ordonnée)``), les axes (un par panneau).
+    """
+    from ..figures import new_figure
+    from ..numbers import french_figure
+
+    panels = tuple(panels)
+    height = sum(p.height for p in panels) / height_px_per_inch
+    shared = not any(p.own_x for p in panels)
+    fig, axes = new_figure(len(panels), 1, width=7.0, height=height, sharex=shared, squeeze=False)
+    axes = axes[:, 0]
+    lines: dict[str, list] = {}
+    for ax, panel in zip(axes, panels):
+        for glyph in panel.glyphs:
+            x = glyph.x
+            if glyph.kind == "hline":
+                ax.axhline(glyph.value, color=glyph.color, lw=1.5, label=glyph.legend)
+                continue
+            style = {"marker": "+", "ls": "none", "ms": 7} if glyph.kind == "scatter" else {"lw": 1.8}
+            (line,) = ax.plot(data[x], data[glyph.column], color=glyph.color, label=glyph.legend, **style)
+            line.kc_columns = (x, glyph.column)  # séries (abscisse, ordonnée) à relire au redessin
+            lines.setdefault(glyph.column, []).append(line)
+        if panel.y_log:
+            ax.set_yscale("log")
+        if panel.y_range is not None:
+            ax.set_ylim(*panel.y_range)
+        if panel.x_range is not None:
+            ax.set_xlim(*panel.x_range)
+        if panel.equal_aspect:
+            ax.set_aspect("equal")
+        ax.set_title(panel.title, fontsize=10)
+        ax.set_ylabel(panel.y_label)
+        ax.set_xlabel(panel.x_label or x_label)
+        ax.grid(alpha=0.3, which="both" if panel.y_log else "major")
+        ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
+    french_figure(fig)  # graduations et nombres des légendes à la française
+    return fig, lines, axes

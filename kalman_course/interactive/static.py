@@ -11,6 +11,11 @@ balises ``<script>`` dans l'en-tête des seules pages qui contiennent une telle 
 l'attribut :data:`MARKER`), une fois par page, avec un chemin relatif qui marche en ``http://`` comme
 en ``file://``. Hors du livre (dans Jupyter), la figure affiche un message qui renvoie vers les
 curseurs vivants (:mod:`kalman_course.interactive.live`).
+
+Le PDF du cours (constructeur LaTeX) ne peut pas animer de curseurs : la figure fournit aussi une
+image PNG (matplotlib, mêmes panneaux, exécution de la position par défaut des curseurs) et une
+légende (:meth:`StaticSliders.caption`, dans l'attribut HTML :data:`CAPTION_ATTRIBUTE`) ; l'extension
+Sphinx place l'image dans une figure légendée du PDF. Le site, lui, affiche toujours le HTML.
 """
 
 from __future__ import annotations
@@ -44,10 +49,12 @@ from ..numbers import bokeh_tick_formatter
 from .grid import ParameterGrid
 from .spec import Panel, check_columns
 
-__all__ = ["MARKER", "BOKEH_VERSION", "PLOTTED_SOURCE", "bokehjs_files", "StaticSliders"]
+__all__ = ["MARKER", "CAPTION_ATTRIBUTE", "BOKEH_VERSION", "PLOTTED_SOURCE", "bokehjs_files", "StaticSliders"]
 
 #: Attribut HTML qui signale une figure à curseurs statiques (lu par l'extension Sphinx).
 MARKER = "data-kc-bokeh"
+#: Attribut HTML qui porte la légende de la figure imprimée (PDF), lue par l'extension Sphinx.
+CAPTION_ATTRIBUTE = "data-kc-caption"
 #: Version de BokehJS attendue par les figures (celle du paquet Python ``bokeh`` installé).
 BOKEH_VERSION = bokeh.__version__
 
@@ -242,6 +249,34 @@ class StaticSliders:
         header = [Div(text=f"<strong>{html.escape(french_spacing(self.title))}</strong>")] if self.title else []
         return column(*header, row(s0, s1, sizing_mode="stretch_width"), *figures, sizing_mode="stretch_width")
 
+    # ------------------------------------------------------------------ image fixe (PDF)
+
+    def default_figure(self):
+        """La figure matplotlib des mêmes panneaux, à la position par défaut des curseurs : les mêmes
+        séries que la figure Bokeh à son ouverture (exécution ``grid.default_index``)."""
+        from .spec import draw_panels
+
+        data = {"t": np.array(self.grid.time), **self.fixed, **self.grid.run(*self.grid.default_index)}
+        fig, _, _ = draw_panels(self.panels, data, self.x_label)
+        return fig
+
+    def caption(self) -> str:
+        """Légende de la figure imprimée : titre et valeurs des curseurs à leur position par défaut."""
+        values = ", ".join(
+            f"{axis.symbol} = {axis.labels()[axis.default]}" for axis in self.grid.axes
+        )
+        n0, n1 = self.grid.shape
+        title = self.title or f"Figure à curseurs « {self.name} »"
+        return (
+            f"{title}. Curseurs à leur position par défaut ({values}) ; dans le livre en ligne, ils "
+            f"parcourent les {n0} × {n1} exécutions précalculées."
+        )
+
+    def _repr_mimebundle_(self, include=None, exclude=None):
+        """HTML (figure Bokeh, pour le site) et PNG de repli (position par défaut, pour le PDF)."""
+        png, size = self.default_figure()._repr_png_()
+        return {"text/html": self.html(), "image/png": png}, {"image/png": size}
+
     # ------------------------------------------------------------------ sortie HTML
 
     def html(self) -> str:
@@ -262,7 +297,8 @@ class StaticSliders:
             f"Dans Jupyter, utilisez les curseurs vivants{hint}."
         )
         return (
-            f'<div class="kc-bokeh-figure" {MARKER}="{self.name}" data-bokeh-version="{BOKEH_VERSION}">\n'
+            f'<div class="kc-bokeh-figure" {MARKER}="{self.name}" data-bokeh-version="{BOKEH_VERSION}" '
+            f'{CAPTION_ATTRIBUTE}="{html.escape(self.caption(), quote=True)}">\n'
             f'<div id="{root_id}" class="kc-bokeh-root"><p class="kc-bokeh-missing">{missing}</p></div>\n'
             f'<script type="application/json" id="{root_id}-item">{item}</script>\n'
             "<script>(function () {\n"
