@@ -68,6 +68,20 @@ from . import se3_filter
 manifold = se3_filter  # ancien nom du module
 from .geometry.camera import PinholeCamera, camera_measurement, camera_measurement_jacobian
 from .geometry.lie import oplus, ominus, se3_adjoint, se3_exp, se3_log, se3_right_jacobian
+# --- issue 10 : lissage, vraisemblance, apprentissage de Q et R (début) -----------------------------
+from . import likelihood
+from .filters.diffuse import DiffuseFilterResult, diffuse_kalman_filter
+from .filters.smoothers import SmootherResult, extended_rts_smoother, rts_smoother
+from .likelihood import (
+    EMResult,
+    MaximumLikelihood,
+    expectation_maximization,
+    filter_log_likelihood,
+    log_likelihood,
+    log_likelihood_terms,
+    maximum_likelihood,
+)
+# --- issue 10 (fin) ---------------------------------------------------------------------------------
 from .se3_filter import (
     SE3FilterResult,
     SE3Update,
@@ -171,6 +185,22 @@ __all__ = [
     "errata_se3",
     "lie",
     "manifold",
+    # issue 10 : lissage, vraisemblance, apprentissage de Q et R (début)
+    "DiffuseFilterResult",
+    "diffuse_kalman_filter",
+    "SmootherResult",
+    "rts_smoother",
+    "extended_rts_smoother",
+    "log_likelihood_terms",
+    "filter_log_likelihood",
+    "log_likelihood",
+    "MaximumLikelihood",
+    "maximum_likelihood",
+    "EMResult",
+    "expectation_maximization",
+    "likelihood",
+    "datasets",
+    # issue 10 (fin)
     # sous-modules
     "errata",
     "figures",
@@ -182,9 +212,10 @@ __version__ = "0.1.0"
 
 
 def __getattr__(name: str):
-    # ``kc.interactive`` à la demande : bokeh et ipywidgets ne sont importés que si l'on s'en sert.
-    if name == "interactive":
+    # ``kc.interactive`` à la demande : bokeh et ipywidgets ne sont importés que si l'on s'en sert ;
+    # ``kc.datasets`` de même (statsmodels, pandas).
+    if name in ("interactive", "datasets"):
         import importlib
 
-        return importlib.import_module(".interactive", __name__)
+        return importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module 'kalman_course' has no attribute {name!r}")
