@@ -319,7 +319,8 @@ def maximum_likelihood(
                 f"« theta0 » a-t-il la bonne longueur ({theta0.size}) ?"
             )
     try:
-        ll0 = log_likelihood(model0, Y, x0, P0, U)
+        with np.errstate(over="ignore", invalid="ignore"):  # une valeur non finie est traitée ci-dessous
+            ll0 = log_likelihood(model0, Y, x0, P0, U)
     except KalmanInputError as exc:
         raise KalmanInputError(f"La log-vraisemblance n'est pas calculable en « theta0 » : {exc}") from exc
     if not np.isfinite(ll0):
@@ -330,7 +331,8 @@ def maximum_likelihood(
             model = build(np.array(theta, dtype=float))
             if not isinstance(model, LinearGaussianModel):
                 raise KalmanInputError("modèle invalide")
-            value = log_likelihood(model, Y, x0, P0, U)
+            with np.errstate(over="ignore", invalid="ignore"):
+                value = log_likelihood(model, Y, x0, P0, U)
         except KalmanInputError:
             return -np.inf
         return value if np.isfinite(value) else -np.inf

@@ -264,7 +264,9 @@ def diffuse_kalman_filter(model: LinearGaussianModel, y: Any, u: Any = None) -> 
     if rows.any():
         o = obs[rows]
         C_o = np.where(o[:, :, None], model.C[None], 0.0)  # lignes manquantes de C mises à 0
-        nu = np.where(o, augmented.innovation[rows], 0.0) - (C_o @ x_pred[rows][:, :, None])[:, :, 0]
+        # ν = y − C x̂⁻ = v − C(x̂⁻ − a⁻) : l'innovation du filtre conditionnel, corrigée de X⁻δ̂
+        shift = x_pred[rows] - augmented.x_pred[rows][:, :, 0]
+        nu = np.where(o, augmented.innovation[rows], 0.0) - (C_o @ shift[:, :, None])[:, :, 0]
         S_rows = C_o @ P_pred[rows] @ np.swapaxes(C_o, 1, 2) + model.R
         _, S_solve = masked_innovations(nu, S_rows, o)
         K[rows] = np.swapaxes(np.linalg.solve(S_solve, C_o @ P_pred[rows]), 1, 2)
