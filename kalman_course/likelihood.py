@@ -52,7 +52,15 @@ from .core.linalg import symmetrize
 from .core.models import LinearGaussianModel
 from .core.results import FilterResult, freeze
 from .core.validation import KalmanInputError, as_controls, as_float_array, as_measurements, check_instance, shape_text
-from .filters.diffuse import DiffuseFilterResult, diffuse_kalman_filter, is_determined, masked_innovations
+from .filters.diffuse import (
+    DiffuseFilterResult,
+    diffuse_family,
+    diffuse_information,
+    diffuse_kalman_filter,
+    is_determined,
+    masked_innovations,
+)
+from .filters.engine import run_filter
 from .filters.kalman import kalman_filter
 from .filters.smoothers import rts_smoother
 
@@ -122,16 +130,7 @@ def filter_log_likelihood(result: FilterResult) -> float:
     """
     check_instance("result", result, FilterResult, "la sortie d'un filtre, par exemple kalman_filter")
     if isinstance(result, DiffuseFilterResult):
-        J, h = result.information[-1], result.information_vector[-1]
-        if not is_determined(J):
-            raise KalmanInputError(
-                "Les mesures ne déterminent pas l'état (information J_T singulière : modèle non observable "
-                "ou trop peu de mesures) : la vraisemblance diffuse n'est pas définie."
-            )
-        base = float(np.sum(log_likelihood_terms(result.augmented)))
-        L = scipy.linalg.cholesky(J, lower=True)
-        w = scipy.linalg.solve_triangular(L, h, lower=True)
-        return base + 0.5 * float(w @ w) - float(np.sum(np.log(np.diag(L))))
+        return _diffuse_value(result.augmented, result.information[-1], result.information_vector[-1])
     terms = log_likelihood_terms(result)
     if np.isnan(terms).any():
         k = int(np.argmax(np.isnan(terms)))
@@ -140,6 +139,20 @@ def filter_log_likelihood(result: FilterResult) -> float:
             "log_likelihood(model, y) sans x0 ni P0 (vraisemblance diffuse exacte), ou log_likelihood_terms."
         )
     return float(np.sum(terms))
+
+
+def _diffuse_value(augmented: FilterResult, J: np.ndarray, h: np.ndarray) -> float:
+    r""":math:`\log L_d` à partir du filtre augmenté et de :math:`J_T`, :math:`h_T` (voir le module) :
+    :math:`\sum_k \ell_k(v_k, S_k) + \tfrac12 h_T^TJ_T^{-1}h_T - \tfrac12\log|J_T|`, par Cholesky de :math:`J_T`."""
+    if not is_determined(J):
+        raise KalmanInputError(
+            "Les mesures ne déterminent pas l'état (information J_T singulière : modèle non observable "
+            "ou trop peu de mesures) : la vraisemblance diffuse n'est pas définie."
+        )
+    base = float(np.sum(log_likelihood_terms(augmented)))
+    L = scipy.linalg.cholesky(J, lower=True)
+    w = scipy.linalg.solve_triangular(L, h, lower=True)
+    return base + 0.5 * float(w @ w) - float(np.sum(np.log(np.diag(L))))
 
 
 def _prior(x0: Any, P0: Any) -> bool:
@@ -177,7 +190,12 @@ def log_likelihood(model: LinearGaussianModel, y: Any, x0: Any = None, P0: Any =
     Renvoie un ``float`` (nats).
     """
     check_instance("model", model, LinearGaussianModel, "la vraisemblance est celle d'un modèle linéaire gaussien")
-    return filter_log_likelihood(_filter(model, y, x0, P0, u))
+    if _prior(x0, P0):
+        return filter_log_likelihood(kalman_filter(model, y, x0, P0, u))
+    # départ diffus : le filtre augmenté et l'information suffisent (pas besoin des estimations exactes)
+    augmented = run_filter(diffuse_family(), model, y, None, None, u)
+    J, h = diffuse_information(model, augmented)
+    return _diffuse_value(augmented, J[-1], h[-1])
 
 
 # --------------------------------------------------------------------------- maximum de vraisemblance
