@@ -242,6 +242,19 @@ def test_extended_rts_on_a_pendulum_follows_the_formulas_and_beats_the_filter():
     assert err_s < 0.8 * err_f
 
 
+def test_extended_rts_accepts_the_iterated_ekf():
+    """L'EKF itéré prédit comme l'EKF : son résultat se lisse avec les mêmes formules (F_k en x̂_{k|k})."""
+    model, F = _pendulum()
+    rng = np.random.default_rng(8)
+    y = np.sin(1.0 + 0.1 * rng.standard_normal((60, 1))) + 0.2 * rng.standard_normal((60, 1))
+    res = kc.iterated_extended_kalman_filter(model, y, [0.8, 0.0], np.diag([0.5, 0.5]))
+    assert (res.n_iter > 1).any()
+    sm = kc.extended_rts_smoother(model, res)
+    k = 30
+    G = res.P[k] @ F(res.x[k], None).T @ np.linalg.inv(res.P_pred[k + 1])
+    np.testing.assert_allclose(sm.x[k], res.x[k] + G @ (sm.x[k + 1] - res.x_pred[k + 1]), rtol=1e-9, atol=1e-12)
+
+
 # --------------------------------------------------------------------------- entrées invalides
 
 
@@ -323,3 +336,65 @@ def test_unobservable_model_cannot_be_smoothed_without_prior():
     assert np.isnan(res.x).all()  # la seconde composante n'est jamais observée
     with pytest.raises(kc.KalmanInputError, match="ne déterminent pas l'état"):
         kc.rts_smoother(model, res)
+
+
+# --------------------------------------------------------------------------- curseurs du Nil (chapitre « Lissage »)
+
+
+@pytest.fixture(scope="module")
+def nile_grid():
+    import kalman_course.interactive as ki
+
+    return ki.nile_grid()
+
+
+def test_nile_slider_grid_equals_statsmodels_smoother(nile_grid):
+    import statsmodels.api as sm
+
+    y = kc.datasets.nile(missing=True).flow
+    R_axis, Q_axis = nile_grid.axes
+    assert (R_axis.default_value, Q_axis.default_value) == kc.scenarios.nile.NILE_DK_VARIANCES
+    for i, j in [nile_grid.default_index, (0, 0), (6, 10), (1, 7)]:
+        R, Q = R_axis.values[i], Q_axis.values[j]
+        ref = sm.tsa.UnobservedComponents(y, "llevel", use_exact_diffuse=True).smooth([R, Q])
+        run = nile_grid.run(i, j)
+        np.testing.assert_allclose(run["xs"], ref.smoothed_state[0], rtol=1e-9)
+        np.testing.assert_allclose(run["ss"] ** 2, ref.smoothed_state_cov[0, 0], rtol=1e-8)
+        np.testing.assert_allclose(run["xf"], ref.filtered_state[0], rtol=1e-9)
+
+
+def test_nile_slider_prose_claims(nile_grid):
+    """Les affirmations de l'encadré « À observer » du chapitre « Lissage »."""
+    y = kc.datasets.nile(missing=True).flow
+    seen = ~np.isnan(y)
+    i0, j0 = nile_grid.default_index
+    # Q au minimum : niveau lissé presque plat, proche de la moyenne des mesures
+    flat = nile_grid.run(i0, 0)
+    assert np.ptp(flat["xs"]) < 0.1 * np.nanstd(y)
+    assert abs(flat["xs"].mean() - np.nanmean(y)) < 0.01 * np.nanmean(y)
+    # Q au maximum : le niveau filtré suit les mesures
+    wild = nile_grid.run(i0, nile_grid.shape[1] - 1)
+    assert np.max(np.abs(wild["xf"][seen] - y[seen])) < 0.15 * np.max(np.abs(flat["xf"][seen] - y[seen]))
+    # années retirées : niveau filtré figé, écart-type croissant ; écart-type lissé en lentille
+    base = nile_grid.run(i0, j0)
+    gap = slice(20, 40)
+    assert np.ptp(base["xf"][gap]) == 0.0 and (np.diff(base["sf"][gap]) > 0).all()
+    k_max = 20 + int(np.argmax(base["ss"][gap]))
+    assert 27 <= k_max <= 32
+    # un cran de chaque curseur : mêmes niveaux, écarts-types × 10^(1/4)
+    a, b = nile_grid.run(2, 5), nile_grid.run(3, 6)
+    np.testing.assert_allclose(b["xs"], a["xs"], rtol=1e-10)
+    np.testing.assert_allclose(b["ss"] / a["ss"], 10 ** 0.25, rtol=1e-10)
+
+
+def test_target_scenario_claims():
+    """Les affirmations du chapitre « Lissage » sur la cible : le lisseur bat le filtre, surtout dans le trou."""
+    run = kc.scenarios.smoothing.target_run()
+    assert run.rmse_smoother < 0.7 * run.rmse_filter
+    assert run.rmse_smoother_gap < 0.7 * run.rmse_filter_gap
+    g0, g1 = run.gap
+    sd_f, sd_s = run.filtered.std()[:, 0], run.smoothed.std()[:, 0]
+    assert (np.diff(sd_f[g0:g1]) > 0).all()  # le filtre ne fait que perdre confiance dans le trou
+    k = g0 + int(np.argmax(sd_s[g0:g1]))
+    assert g0 + 5 <= k <= g1 - 5  # lentille : maximum loin des bords
+    assert sd_s[-1] == sd_f[-1]

@@ -41,7 +41,7 @@ def _level_panel(ax, run, title: str, filtered: bool = True) -> None:
     ax.plot(years, mean, color=SMOOTHER_COLOR, lw=2.0, label="niveau lissé")
     ax.fill_between(years, mean - 2 * sd, mean + 2 * sd, color=SMOOTHER_COLOR, alpha=0.2, lw=0,
                     label="lissé ± 2σ")
-    ax.set_xlabel("année")
+    ax.set_xlabel("temps (année)")
     ax.set_ylabel(FLOW)
     ax.set_title(title)
     ax.xaxis.set_major_formatter(_year_formatter())
@@ -86,7 +86,7 @@ def diffuse_start():
               label=r"$|\log L_\kappa + \frac{1}{2}\log\kappa - \log L_d|$")
     ref = gap[4] * KAPPAS[4] / KAPPAS
     ax.loglog(KAPPAS, ref, "--", color="0.5", lw=1, label=r"pente $1/\kappa$")
-    ax.set_xlabel(r"variance a priori $P_0 = \kappa$ ((10⁸ m³)²)")
+    ax.set_xlabel(r"variance a priori $P_0 = \kappa$ (10¹⁶ m⁶)")
     ax.set_ylabel("écart à la vraisemblance diffuse exacte (nats)")
     ax.set_title(r"Filtre de Kalman avec $P_0 = \kappa$ : convergence puis arrondis")
     decades(ax.xaxis)
@@ -101,7 +101,7 @@ def likelihood_surface_figure():
     surf = likelihood_surface()
     fit = nile_fit()
     em = nile_em()
-    fig, ax = new_figure(width=7.2, height=5.0)
+    fig, ax = new_figure(width=6.8, height=5.0)
     top = float(np.max(surf.log_likelihood))
     best = max(top, fit.log_likelihood)
     gaps = np.array([-1000.0, -200, -100, -50, -20, -10, -5, -2, -1, -0.5, 0.0])
@@ -110,20 +110,18 @@ def likelihood_surface_figure():
 
     norm = BoundaryNorm(gaps, ncolors=256)  # une couleur bien distincte par bande
     filled = ax.contourf(surf.sigma2_eps, surf.sigma2_eta, rel, levels=gaps, cmap="viridis", norm=norm)
-    ax.contour(surf.sigma2_eps, surf.sigma2_eta, rel, levels=gaps[1:-1], colors="white", linewidths=0.5,
-               linestyles="solid")
-    bar = fig.colorbar(filled, ax=ax, ticks=gaps[1:], spacing="uniform")
-    bar.set_label(r"$\log L - \log L_{\max}$ (nats)")
-    bar.ax.yaxis.set_major_formatter(matplotlib_formatter())
+    lines = ax.contour(surf.sigma2_eps, surf.sigma2_eta, rel, levels=gaps[1:-1], colors="white", linewidths=0.6,
+                       linestyles="solid")
+    ax.clabel(lines, fmt=lambda v: format_number(v, significant=2), fontsize=7, colors="white")
     ax.plot(em.R[:, 0, 0], em.Q[:, 0, 0], ".-", color="tab:red", ms=3, lw=1.0, label="itérés d'EM")
     var = np.exp(fit.theta)
     ax.plot(*var, "*", color="black", ms=14, label="maximum de vraisemblance")
     ax.plot(*NILE_DK_VARIANCES, "x", color="tab:orange", ms=9, mew=2, label="Durbin & Koopman (2012)")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel(r"$R = \sigma^2_\varepsilon$ ((10⁸ m³)²)")
-    ax.set_ylabel(r"$Q = \sigma^2_\eta$ ((10⁸ m³)²)")
-    ax.set_title("Log-vraisemblance diffuse exacte du niveau local")
+    ax.set_xlabel(r"$R = \sigma^2_\varepsilon$ (10¹⁶ m⁶)")
+    ax.set_ylabel(r"$Q = \sigma^2_\eta$ (10¹⁶ m⁶)")
+    ax.set_title(r"Courbes de niveau de $\log L - \log L_{\max}$ (nats), départ diffus exact")
     decades(ax.xaxis)
     decades(ax.yaxis)
     ax.legend(fontsize=8, loc="lower left", framealpha=0.9)
@@ -170,7 +168,7 @@ def nile_residuals():
     for v in (-2.0, 2.0):
         ax.axhline(v, color="0.4", lw=0.8, ls="--")
     ax.plot(diag.years, diag.standardized, "o-", ms=3, lw=0.8, color="tab:blue")
-    ax.set_xlabel("année")
+    ax.set_xlabel("temps (année)")
     ax.set_ylabel(r"$\nu_k/\sqrt{S_k}$ (sans unité)")
     ax.set_title("Innovations normalisées (± 2 en tirets)")
     ax.xaxis.set_major_formatter(_year_formatter())
@@ -215,7 +213,7 @@ def em_convergence():
     for v in var:
         ax.axhline(v, color="0.3", lw=0.8, ls=":")
     ax.set_xlabel("itération d'EM")
-    ax.set_ylabel("variance ((10⁸ m³)²)")
+    ax.set_ylabel("variance (10¹⁶ m⁶)")
     ax.set_title("Variances itérées (pointillés : MV)")
     ax.xaxis.set_major_formatter(matplotlib_formatter())
     log_axis(ax)

@@ -187,8 +187,8 @@ def _check_consistency(result: FilterResult, P_pred_next: np.ndarray, x_pred_nex
                        H: np.ndarray, Rn: np.ndarray, filters: str, where: str) -> None:
     r"""Le résultat doit être celui du filtre de ce modèle : :math:`P^-_{k+1}` (et :math:`\hat x^-_{k+1}`
     si fourni) recalculés depuis la ligne ``k``, :math:`S_k = HP^-_kH^T + R` sur les composantes
-    observées. ``P_pred_next`` (T-1, n, n), ``x_pred_next`` (T-1, n) ou (T-1, n, c), ``H`` (T, m, n)
-    ou (m, n), ``Rn`` (T, m, m) ou (m, m)."""
+    observées (si ``H`` est donnée). ``P_pred_next`` (T-1, n, n), ``x_pred_next`` (T-1, n) ou
+    (T-1, n, c), ``H`` (T, m, n), (m, n) ou None, ``Rn`` (T, m, m) ou (m, m)."""
     if result.n_steps > 1:
         ref = result.P_pred[1:]
         err = _close(P_pred_next, ref, np.max(np.abs(ref), axis=(1, 2)))
@@ -205,7 +205,7 @@ def _check_consistency(result: FilterResult, P_pred_next: np.ndarray, x_pred_nex
                 raise _mismatch(where, "la prédiction x_pred[k+1] = f(x[k], u)", k, float(err[k]), filters)
     obs = np.asarray(result.observed, dtype=bool)
     rows = obs.any(axis=1)
-    if rows.any():
+    if H is not None and rows.any():
         Hs = np.broadcast_to(H, (result.n_steps,) + np.shape(H)[-2:])[rows]
         Rs = np.broadcast_to(Rn, (result.n_steps,) + np.shape(Rn)[-2:])[rows]
         S = Hs @ result.P_pred[rows] @ np.swapaxes(Hs, 1, 2) + Rs
@@ -406,11 +406,16 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
         F[k] = model.transition_jacobian(x[k], control(k + 1))
         Qn[k] = model.process_noise(x[k], control(k + 1))
         fx[k] = model.transition(x[k], control(k + 1))
-    H = np.empty((T, m, n))
-    Rn = np.empty((T, m, m))
-    for k in range(T):
-        H[k] = model.observation_jacobian(result.x_pred[k])
-        Rn[k] = model.measurement_noise(result.x_pred[k])
+    # S_k = H P⁻ Hᵀ + VRVᵀ en x̂⁻ pour l'EKF ; l'EKF itéré linéarise ailleurs (dernier itéré) : seule sa
+    # prédiction, la même que celle de l'EKF, est alors vérifiée
+    H = Rn = None
+    iterated = result.n_iter is not None and bool((np.asarray(result.n_iter) > 1).any())
+    if not iterated:
+        H = np.empty((T, m, n))
+        Rn = np.empty((T, m, m))
+        for k in range(T):
+            H[k] = model.observation_jacobian(result.x_pred[k])
+            Rn[k] = model.measurement_noise(result.x_pred[k])
     _check_consistency(result, symmetrize(F @ P[:-1] @ np.swapaxes(F, 1, 2) + Qn), fx, H, Rn,
                        "filtre de Kalman étendu", " et les mêmes commandes « u » (extended_rts_smoother lisse la "
                        "sortie d'extended_kalman_filter)")

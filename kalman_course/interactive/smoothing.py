@@ -28,9 +28,9 @@ def nile_axes(per_decade: int = 2) -> tuple[ParameterAxis, ParameterAxis]:
     décade (7 × 11 par défaut) ; la position par défaut est exactement la valeur publiée."""
     eps, eta = NILE_DK_VARIANCES
     return (
-        ParameterAxis("R", "R = σ²ε", "variance du bruit de mesure", UNIT, log_grid(eps, 2, 1, per_decade),
+        ParameterAxis("R", "R = σ²ε", "bruit de mesure", UNIT, log_grid(eps, 2, 1, per_decade),
                       default=2 * per_decade),
-        ParameterAxis("Q", "Q = σ²η", "variance du bruit d'état (dérive du niveau)", UNIT,
+        ParameterAxis("Q", "Q = σ²η", "dérive du niveau", UNIT,
                       log_grid(eta, 3, 2, per_decade), default=3 * per_decade),
     )
 
@@ -58,7 +58,7 @@ def nile_panels() -> tuple[Panel, ...]:
               y_range=(400.0, 1450.0), height=280),
         Panel("Écart-type du niveau", "écart-type (10⁸ m³)",
               (Glyph("sf", "line", "darkorange", "filtre"), Glyph("ss", "line", "royalblue", "lisseur")),
-              y_log=True),
+              y_log=True, y_range=(2.0, 2000.0)),
     )
 
 
