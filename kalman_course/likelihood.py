@@ -63,7 +63,6 @@ from .filters.diffuse import (
 from .filters.engine import run_filter
 from .filters.kalman import kalman_filter
 from .filters.smoothers import rts_smoother
-from .numbers import format_number
 
 __all__ = [
     "log_likelihood_terms",
@@ -231,6 +230,8 @@ class MaximumLikelihood:
             object.__setattr__(self, name, freeze(getattr(self, name)))
 
     def __repr__(self) -> str:
+        from .numbers import format_number  # Babel, chargé à l'affichage seulement
+
         theta = " ; ".join(format_number(v, significant=6) for v in self.theta)
         return (f"<MaximumLikelihood : log L = {format_number(self.log_likelihood, decimals=4)}, θ = ({theta}), "
                 f"{'convergé' if self.converged else 'non convergé'} ({self.n_evaluations} évaluations)>")
@@ -408,6 +409,8 @@ class EMResult:
             object.__setattr__(self, name, freeze(getattr(self, name)))
 
     def __repr__(self) -> str:
+        from .numbers import format_number  # Babel, chargé à l'affichage seulement
+
         return (f"<EMResult : {self.n_iter} itérations, log L = {format_number(self.log_likelihood, decimals=5)}, "
                 f"{'convergé' if self.converged else 'non convergé'}>")
 

@@ -142,13 +142,16 @@ def rts_pass(x: np.ndarray, P: np.ndarray, x_pred: np.ndarray, P_pred: np.ndarra
     T = x.shape[0]
     xs = np.empty_like(x)
     Ps = np.empty_like(P)
-    lag = np.full_like(P, np.nan)
     xs[-1], Ps[-1] = x[-1], P[-1]
+    x_next, P_next = xs[-1], Ps[-1]
     for k in range(T - 2, -1, -1):
         Gk = G[k]
-        xs[k] = x[k] + Gk.dot(xs[k + 1] - x_pred[k + 1])
-        Ps[k] = symmetrize(P[k] + Gk.dot(Ps[k + 1] - P_pred[k + 1]).dot(Gk.T))
-        lag[k + 1] = Ps[k + 1].dot(Gk.T)
+        x_next = x[k] + Gk.dot(x_next - x_pred[k + 1])
+        Pk = P[k] + Gk.dot(P_next - P_pred[k + 1]).dot(Gk.T)
+        P_next = 0.5 * (Pk + Pk.T)  # symétrisation (arrondis)
+        xs[k], Ps[k] = x_next, P_next
+    lag = np.full_like(P, np.nan)
+    lag[1:] = Ps[1:] @ np.swapaxes(G[:-1], 1, 2)  # Cov(x_{k+1}, x_k | y) = P_{k+1|T} G_kᵀ
     return xs, Ps, lag
 
 
