@@ -71,6 +71,19 @@ from . import se3_filter
 manifold = se3_filter  # ancien nom du module
 from .geometry.camera import PinholeCamera, camera_measurement, camera_measurement_jacobian
 from .geometry.lie import oplus, ominus, se3_adjoint, se3_exp, se3_log, se3_right_jacobian
+# lissage, vraisemblance, apprentissage de Q et R
+from . import likelihood
+from .filters.diffuse import DiffuseFilterResult, diffuse_kalman_filter
+from .filters.smoothers import SmootherResult, extended_rts_smoother, rts_smoother
+from .likelihood import (
+    EMResult,
+    MaximumLikelihood,
+    expectation_maximization,
+    filter_log_likelihood,
+    log_likelihood,
+    log_likelihood_terms,
+    maximum_likelihood,
+)
 from .se3_filter import (
     SE3FilterResult,
     SE3Update,
@@ -176,6 +189,21 @@ __all__ = [
     "errata_se3",
     "lie",
     "manifold",
+    # lissage, vraisemblance, apprentissage de Q et R
+    "DiffuseFilterResult",
+    "diffuse_kalman_filter",
+    "SmootherResult",
+    "rts_smoother",
+    "extended_rts_smoother",
+    "log_likelihood_terms",
+    "filter_log_likelihood",
+    "log_likelihood",
+    "MaximumLikelihood",
+    "maximum_likelihood",
+    "EMResult",
+    "expectation_maximization",
+    "likelihood",
+    "datasets",
     # sous-modules
     "errata",
     "figures",

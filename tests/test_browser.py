@@ -42,7 +42,7 @@ CHROMIUM_ARGS = [
 # page_errors vérifie qu'il n'en reste qu'une.)
 
 #: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet).
-EXPECTED_GRIDS = {"tension-curseurs": ki.voltage_grid, "tag-curseurs": ki.tag_grid}
+EXPECTED_GRIDS = {"tension-curseurs": ki.voltage_grid, "tag-curseurs": ki.tag_grid, "nil-curseurs": ki.nile_grid}
 
 
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):

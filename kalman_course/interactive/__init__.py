@@ -5,6 +5,7 @@
 - :func:`live_voltage_explorer` : curseurs ipywidgets (Φ, Ψ, P₀) qui relancent le filtre ; il faut un
   noyau (Jupyter, Binder, Colab).
 - :func:`tag_sliders`, :func:`live_tag_explorer` : les mêmes pour l'EKF du tag UWB (σₐ, σᵣ).
+- :func:`nile_sliders`, :func:`live_nile_explorer` : le Nil filtré et lissé (R, Q), chapitre « Lissage ».
 - :mod:`.grid` : les grilles précalculées (numpy seulement) ; :mod:`.sphinx_ext` : l'extension Sphinx
   qui sert BokehJS aux pages qui en ont besoin.
 
@@ -15,6 +16,7 @@ from .grid import ParameterAxis, ParameterGrid, format_value, log_grid, precompu
 from .live import LiveExplorer, LogParameter
 from .spec import Glyph, Panel
 from .static import StaticSliders
+from .smoothing import live_nile_explorer, nile_axes, nile_grid, nile_slider_run, nile_sliders
 from .tag import live_tag_explorer, tag_axes, tag_grid, tag_run, tag_sliders
 from .voltage import live_voltage_explorer, voltage_axes, voltage_grid, voltage_run, voltage_sliders
 
@@ -27,9 +29,14 @@ __all__ = [
     "ParameterGrid",
     "StaticSliders",
     "format_value",
+    "live_nile_explorer",
     "live_tag_explorer",
     "live_voltage_explorer",
     "log_grid",
+    "nile_axes",
+    "nile_grid",
+    "nile_slider_run",
+    "nile_sliders",
     "precompute_grid",
     "tag_axes",
     "tag_grid",
