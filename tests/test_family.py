@@ -3,7 +3,9 @@ linéaire est comparé à la référence indépendante (la boucle ``predict()``/
 mêmes données — mêmes ``x`` et ``P`` à 1e-9, même traitement des mesures manquantes, mêmes erreurs
 d'entrée (elles viennent du moteur commun).
 
-Les filtres à venir (UKF du paquet, filtre particulaire, lisseurs) rejoignent la liste ``FILTERS``.
+Les filtres de Monte-Carlo (filtre particulaire, EnKF) rejoignent la famille **statistiquement** (liste
+``STOCHASTIC``) : même moteur, mêmes erreurs d'entrée, mêmes pas sans mesure, et une moyenne qui tend vers
+celle du filtre de Kalman quand le nombre de particules ou de membres croît.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ def _nonlinear(model):
 
 
 def _ukf(model, y, x0, P0, u=None):
-    return kc.filterpy_unscented_filter(_nonlinear(model), y, x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0)
+    return kc.unscented_kalman_filter(_nonlinear(model), y, x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0)
 
 
 FILTERS = [
@@ -51,7 +53,7 @@ FILTERS = [
         m, y, x0, P0, u, method="joint")),
     Member("SRIF étendu", lambda m, y, x0, P0, u=None: kc.extended_square_root_information_filter(
         _nonlinear(m), y, x0, P0, u)),
-    Member("UKF de filterpy (α=1, β=2, κ=0)", _ukf, partial_rows=False),
+    Member("UKF (α=1, β=2, κ=0)", _ukf),
 ]
 IDS = [f.name for f in FILTERS]
 
@@ -113,13 +115,6 @@ def test_partial_rows_use_only_the_observed_components(member):
         np.testing.assert_allclose(res.P[k], f.P, **TOL)
     assert res.observed[4].tolist() == [True, False] and np.isnan(res.innovation[4, 1])
     assert np.all(res.K[4][:, 1] == 0) and np.isnan(res.S[4][1]).all()
-
-
-def test_ukf_adapter_refuses_partial_rows_with_a_french_error():
-    model, y, x0, P0, u = _case(5, 3, 2, 1, T=10)
-    y[4, 1] = np.nan
-    with pytest.raises(kc.KalmanInputError, match="partiellement manquantes"):
-        _ukf(model, y, x0, P0, u)
 
 
 def test_nis_is_consistent_on_every_member():

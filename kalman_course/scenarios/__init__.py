@@ -10,12 +10,14 @@ from .voltage import (
 from . import engine, radar, tag  # noqa: F401  (moteur 2×2 ; suivi du tag UWB ; radar de l'EKF itéré)
 from . import camera_target  # noqa: F401  (pose d'une cible vue par une caméra, EKF itéré sur SE(3))
 from . import diffuse  # noqa: F401  (départ sans a priori : SRIF contre filtre de Kalman)
+from . import pendulum  # noqa: F401  (pendule : UKF, filtre particulaire)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
 __all__ = [
     "diffuse",
     "engine",
+    "pendulum",
     "position_rmse",
     "radar",
     "radar_iterations",
