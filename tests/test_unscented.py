@@ -122,14 +122,6 @@ def test_mean_error_orders_two_four_six():
     np.testing.assert_allclose(slopes, [2.0, 4.0, 6.0], atol=0.05)
 
 
-def test_covariance_ellipse_is_the_two_sigma_contour():
-    cov = np.array([[2.0, 0.6], [0.6, 0.5]])
-    pts = banana.covariance_ellipse([1.0, -1.0], cov, n_sigma=2.0, n_points=50)
-    d = pts - [1.0, -1.0]
-    np.testing.assert_allclose(np.einsum("ij,jk,ik->i", d, np.linalg.inv(cov), d), 4.0, rtol=1e-10)
-    np.testing.assert_allclose(pts[0], pts[-1])
-
-
 # --------------------------------------------------------------------------- le filtre contre filterpy
 
 

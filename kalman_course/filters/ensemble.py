@@ -75,9 +75,12 @@ def _angles(model: NonlinearModel, idx) -> list[int]:
     return [j for j, i in enumerate(idx) if int(i) in model.angle_indices]
 
 
-def ensemble_family(n_members: int, keep_members: bool = False) -> FilterFamily:
-    r"""Les étapes de l'EnKF stochastique pour le moteur (famille ``stochastic``)."""
+def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = True) -> FilterFamily:
+    r"""Les étapes de l'EnKF stochastique pour le moteur (famille ``stochastic``) ; ``perturb=False``
+    retire les perturbations :math:`v^i` des observations (pour montrer pourquoi elles sont nécessaires)."""
     N = check_positive_int("n_members", n_members, minimum=2)
+    if not isinstance(perturb, (bool, np.bool_)):
+        raise KalmanInputError(f"« perturb » doit être un booléen ; reçu {perturb!r}.")
 
     def prior(model, x0, P0, rng):
         if model.f_noise_jacobian is not None or model.h_noise_jacobian is not None:
@@ -116,8 +119,9 @@ def ensemble_family(n_members: int, keep_members: bool = False) -> FilterFamily:
                 f"EnKF, analyse par y[{state.k}] : la covariance d'innovation P_yy + R n'est pas définie positive."
             )
         K = Kt.T
-        V = rng.standard_normal((N, R.shape[0])).dot(np.linalg.cholesky(R).T)
-        D = y + V - HX
+        D = y - HX
+        if perturb:
+            D = D + rng.standard_normal((N, R.shape[0])).dot(np.linalg.cholesky(R).T)
         if angles:
             D[:, angles] = wrap_angle(D[:, angles])
         X_new = X + D.dot(K.T)
@@ -151,6 +155,7 @@ def ensemble_kalman_filter(
     n_members: int,
     rng: Any,
     keep_members: bool = False,
+    perturb: bool = True,
 ) -> EnsembleFilterResult:
     r"""Filtre de Kalman d'ensemble stochastique (observations perturbées) sur toutes les mesures.
 
@@ -164,8 +169,11 @@ def ensemble_kalman_filter(
     n_members : taille :math:`N \ge 2` de l'ensemble.
     rng : graine entière ou ``numpy.random.Generator`` (obligatoire).
     keep_members : garder l'ensemble analysé de chaque pas (``members`` (T, N, n)).
+    perturb : perturber les observations (défaut, l'EnKF stochastique) ; ``False`` : même gain sans
+        perturbations — l'ensemble analysé est alors trop resserré, :math:`(I-KH)P(I-KH)^T` au lieu de
+        :math:`(I-KH)P` (démonstration du chapitre).
 
     Renvoie un :class:`EnsembleFilterResult` : ``x`` (T, n) moyenne, ``P`` (T, n, n) covariance
     d'échantillon, ``K`` (T, n, m) gain de l'analyse, ``innovation`` :math:`y - \bar y`, ``S`` :math:`P_{yy} + R`.
     """
-    return run_filter(ensemble_family(n_members, keep_members), model, y, x0, P0, u, rng=rng)
+    return run_filter(ensemble_family(n_members, keep_members, perturb), model, y, x0, P0, u, rng=rng)

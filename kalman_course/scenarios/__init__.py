@@ -12,7 +12,7 @@ from . import camera_target  # noqa: F401  (pose d'une cible vue par une caméra
 from . import diffuse  # noqa: F401  (départ sans a priori : SRIF contre filtre de Kalman)
 from . import pendulum  # noqa: F401  (pendule : UKF, filtre particulaire)
 from . import banana, distant_target  # noqa: F401  (UKF : la « banane » polaire, la cible lointaine)
-from . import growth, convergence  # noqa: F401  (filtre particulaire, EnKF : modèle bimodal, convergence)
+from . import growth, convergence, importance  # noqa: F401  (filtre particulaire, EnKF : bimodal, convergence, poids)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
@@ -21,6 +21,7 @@ __all__ = [
     "convergence",
     "distant_target",
     "growth",
+    "importance",
     "diffuse",
     "engine",
     "pendulum",

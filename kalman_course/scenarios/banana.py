@@ -45,7 +45,6 @@ __all__ = [
     "banana_unscented",
     "banana_comparison",
     "banana_sample",
-    "covariance_ellipse",
     "mean_error_orders",
 ]
 
@@ -182,16 +181,6 @@ def banana_comparison(
         Wm=ut.Wm,
         Wc=ut.Wc,
     )
-
-
-def covariance_ellipse(mean: Any, cov: Any, n_sigma: float = 2.0, n_points: int = 120) -> np.ndarray:
-    r"""Points (n_points, 2) de l'ellipse :math:`\{x : (x - \bar x)^TP^{-1}(x - \bar x) = k^2\}`, :math:`k` =
-    ``n_sigma`` (fermée : le premier point est répété à la fin). Covariance semi-définie positive acceptée."""
-    n_points = check_positive_int("n_points", n_points, minimum=3)
-    lam, V = np.linalg.eigh(np.asarray(cov, dtype=float))
-    t = np.linspace(0.0, 2.0 * np.pi, n_points)
-    circle = np.column_stack([np.cos(t), np.sin(t)])
-    return np.asarray(mean, dtype=float) + n_sigma * (circle * np.sqrt(np.clip(lam, 0.0, None))) @ V.T
 
 
 def mean_error_orders(bearing_stds: Any, *, kappas: tuple[float, ...] = (0.0, 1.0), range_std: float = BANANA_RANGE_STD):

@@ -36,6 +36,8 @@ __all__ = [
     "loglog_slope",
     "particle_convergence",
     "ensemble_convergence",
+    "EnsembleSpread",
+    "ensemble_spread",
 ]
 
 #: Nombre de mesures.
@@ -164,4 +166,37 @@ def ensemble_convergence(sizes: Any = ENSEMBLE_SIZES, n_runs: int = 6, rng: Any 
     return _convergence(
         lambda b, N, g: ensemble_kalman_filter(b.nonlinear, b.y, b.x0, b.P0, n_members=N, rng=g),
         sizes, n_runs, rng, bench, loglik=False,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class EnsembleSpread:
+    r"""Variance de position (m²) au fil du temps : ``kalman`` (:math:`P_{k\mid k}` exact), ``perturbed``
+    (EnKF stochastique) et ``unperturbed`` (même EnKF sans perturber les observations), (T,) chacune ; et
+    les erreurs quadratiques moyennes de position correspondantes ``rmse`` (dict)."""
+
+    kalman: np.ndarray
+    perturbed: np.ndarray
+    unperturbed: np.ndarray
+    rmse: dict
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "kalman", "perturbed", "unperturbed")
+
+
+def ensemble_spread(n_members: int = 200, rng: Any = 1, bench: LinearBenchmark | None = None) -> EnsembleSpread:
+    r"""L'EnKF avec et sans observations perturbées contre le filtre de Kalman sur le banc d'essai
+    linéaire (même graine pour les deux ensembles)."""
+    bench = linear_benchmark() if bench is None else bench
+    ref = kalman_filter(bench.model, bench.y, bench.x0, bench.P0)
+    runs = {flag: ensemble_kalman_filter(bench.nonlinear, bench.y, bench.x0, bench.P0, n_members=n_members,
+                                         rng=rng, perturb=flag)
+            for flag in (True, False)}
+
+    def rmse(x):
+        return float(np.sqrt(np.mean((x[:, 0] - bench.x_true[:, 0]) ** 2)))
+
+    return EnsembleSpread(
+        kalman=ref.P[:, 0, 0], perturbed=runs[True].P[:, 0, 0], unperturbed=runs[False].P[:, 0, 0],
+        rmse={"filtre de Kalman": rmse(ref.x), "EnKF": rmse(runs[True].x), "EnKF sans perturbations": rmse(runs[False].x)},
     )
