@@ -92,3 +92,30 @@ def test_non_additive_noise_is_refused():
     noisy = kc.NonlinearModel(m.f, m.h, [[1.0]], m.R, f_noise_jacobian=[[0.0], [1.0]])
     with pytest.raises(kc.KalmanInputError, match="bruits additifs"):
         kc.ensemble_kalman_filter(noisy, np.zeros((3, 1)), [0.0, 0.0], np.eye(2), n_members=10, rng=0)
+
+
+def test_perturbed_analysis_covariance_identity_of_the_chapter():
+    """(I − KH)P(I − KH)ᵀ + KRKᵀ = (I − KH)P pour le gain optimal (et pas pour un autre gain)."""
+    rng = np.random.default_rng(0)
+    L = rng.standard_normal((3, 3))
+    P, H = L @ L.T + np.eye(3), rng.standard_normal((2, 3))
+    R = np.diag([0.5, 2.0])
+    K = P @ H.T @ np.linalg.inv(H @ P @ H.T + R)
+    I_KH = np.eye(3) - K @ H
+    np.testing.assert_allclose(I_KH @ P @ I_KH.T + K @ R @ K.T, I_KH @ P, atol=1e-12)
+    K2 = 1.1 * K
+    assert not np.allclose((np.eye(3) - K2 @ H) @ P @ (np.eye(3) - K2 @ H).T + K2 @ R @ K2.T, (np.eye(3) - K2 @ H) @ P)
+
+
+def test_unperturbed_analysis_has_the_too_small_covariance():
+    bench = convergence.linear_benchmark(n_steps=1)
+    ref = kc.kalman_filter(bench.model, bench.y, bench.x0, bench.P0)
+    res = kc.ensemble_kalman_filter(bench.nonlinear, bench.y, bench.x0, bench.P0, n_members=200_000, rng=0,
+                                    perturb=False)
+    I_KH = np.eye(2) - ref.K[0] @ np.array(bench.model.C)
+    np.testing.assert_allclose(res.P[0], I_KH @ ref.P_pred[0] @ I_KH.T, rtol=0.02, atol=1e-3)
+    spread = convergence.ensemble_spread()
+    assert spread.unperturbed[-10:].mean() < 0.7 * spread.kalman[-10:].mean()
+    assert abs(spread.perturbed[-10:].mean() / spread.kalman[-10:].mean() - 1) < 0.25
+    with pytest.raises(kc.KalmanInputError, match="« perturb » doit être un booléen"):
+        kc.ensemble_kalman_filter(bench.nonlinear, bench.y, bench.x0, bench.P0, n_members=5, rng=0, perturb="non")

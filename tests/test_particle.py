@@ -275,3 +275,66 @@ def test_resampling_functions_check_their_inputs():
         kc.multinomial_resample([0.5, 0.5], [0.1, 1.0])
     with pytest.raises(kc.KalmanInputError, match="« resampling » doit valoir"):
         kc.resample([0.5, 0.5], "aléatoire", rng=0)
+
+
+# --------------------------------------------------------------------------- formules du chapitre
+
+
+def test_bayes_filter_recursion_on_a_grid_is_the_kalman_filter():
+    """La récurrence du chapitre (prédiction de Chapman–Kolmogorov, correction de Bayes, vraisemblance
+    produit des p(y_k | y_1:k−1)), calculée sur une grille fine pour un modèle linéaire à un état, redonne
+    la moyenne, la variance et la log-vraisemblance du filtre de Kalman."""
+    a, q, r, x0, p0 = 0.9, 0.5, 0.3, 0.5, 2.0
+    model = kc.LinearGaussianModel(a, [[1.0]], q, r)
+    y = kc.simulate(model, [1.0], 30, rng=4).y
+    ref = kc.kalman_filter(model, y, x0, p0)
+    grid = np.linspace(-15, 15, 3001)
+    dx = grid[1] - grid[0]
+    post = scipy.stats.norm.pdf(grid, x0, np.sqrt(p0))
+    transition = scipy.stats.norm.pdf(grid[:, None], a * grid[None, :], np.sqrt(q))  # p(x_k | x_k−1)
+    log_lik = 0.0
+    for k in range(len(y)):
+        prior = transition @ post * dx                                    # ∫ p(x_k | x_k−1) p(x_k−1 | y) dx
+        like = scipy.stats.norm.pdf(y[k, 0], grid, np.sqrt(r))
+        evidence = np.sum(like * prior) * dx                              # p(y_k | y_1:k−1)
+        post = like * prior / evidence
+        log_lik += np.log(evidence)
+        mean = np.sum(grid * post) * dx
+        var = np.sum((grid - mean) ** 2 * post) * dx
+        assert mean == pytest.approx(ref.x[k, 0], abs=1e-6)
+        assert var == pytest.approx(ref.P[k, 0, 0], rel=1e-5)
+    exact = dense_log_likelihood(model, np.array(y), np.array([x0]), np.array([[p0]]))
+    assert log_lik == pytest.approx(exact, abs=1e-6)
+
+
+def test_importance_example_of_the_chapter():
+    """Poids ∝ vraisemblance sur des tirages de l'a priori : l'estimation tend vers la moyenne a posteriori
+    exacte y/(1 + r²) (qui est aussi la correction du filtre de Kalman), ESS entre 1 et N."""
+    from kalman_course.scenarios import importance
+
+    ex = importance.importance_example()
+    post = kc.update(kc.LinearGaussianModel(1.0, [[1.0]], 0.0, ex.r_std**2), 0.0, 1.0, ex.y)
+    assert ex.posterior_mean == pytest.approx(post.x[0]) and ex.posterior_var == pytest.approx(post.P[0, 0])
+    assert 1.0 <= ex.ess <= len(ex.particles)
+    assert ex.ess == pytest.approx(kc.effective_sample_size(ex.weights))
+    big = importance.importance_example(n=400_000, rng=1)
+    se = np.sqrt(ex.posterior_var / big.ess)
+    assert abs(big.estimate - big.posterior_mean) < 5 * se
+
+
+def test_degeneracy_without_resampling():
+    from kalman_course.scenarios import importance
+
+    d = importance.degeneracy()
+    assert d.without[19] * d.n_particles < 2.0 and d.with_.min() > 0.05 and d.resampled.sum() > 10
+
+
+def test_particle_sliders_default_position_is_the_chapter_run():
+    from kalman_course.interactive import particle as ip
+
+    axes = ip.particle_axes()
+    run = ip.particle_run(axes[0].default_value, axes[1].default_value)
+    bench = convergence.linear_benchmark()
+    pf = kc.particle_filter(bench.nonlinear, bench.y, bench.x0, bench.P0, n_particles=1000, rng=ip.PF_SEED)
+    np.testing.assert_array_equal(run["pf"], pf.x[:, 0])
+    np.testing.assert_array_equal(run["ess"], pf.ess / 1000)

@@ -324,3 +324,33 @@ def test_covariance_that_stops_being_positive_definite_names_the_step():
     y[0] = np.nan
     with pytest.raises(kc.KalmanInputError, match=r"UKF, prédiction vers y\[1\] : la covariance a posteriori P"):
         kc.unscented_kalman_filter(model, y, np.zeros(2), np.eye(2), alpha=1.0, kappa=0.0)
+
+
+def test_chapter_formula_for_the_unscented_mean_of_the_banana():
+    """ȳ_UKF = r̄ [1 − 1/(n+λ) + cos(√(n+λ) σθ)/(n+λ)] à θ̄ = 90° (formule du chapitre), pour plusieurs α, κ."""
+    for alpha, kappa, s in ((1.0, 0.0, 0.3), (1.0, 1.0, 0.2), (0.5, 2.0, 0.4), (0.2, 0.0, 0.35)):
+        c = alpha**2 * (2 + kappa)  # n + λ
+        expected = 1 - 1 / c + np.cos(np.sqrt(c) * s) / c
+        ut = banana.banana_unscented(0.02, s, alpha=alpha, kappa=kappa)
+        assert ut.mean[1] == pytest.approx(expected, rel=1e-12)
+
+
+def test_distant_target_iterated_ekf_is_consistent_from_the_start():
+    comp = distant_target.distant_target_comparison(n_runs=20)
+    lo, hi = kc.chi2_band(4, 20, level=0.999)
+    assert lo < comp.nees["EKF itéré"][0] < hi
+    assert comp.nees["UKF"][0] > hi and comp.nees["EKF"][0] > comp.nees["UKF"][0]
+
+
+def test_banana_sliders_default_positions_are_the_chapter_figure():
+    from kalman_course.interactive import unscented as iu
+
+    sig, rad = iu.banana_uncertainty_axes()
+    assert np.deg2rad(sig.default_value) == banana.BANANA_BEARING_STD and rad.default_value == banana.BANANA_RANGE_STD
+    alpha, kappa = iu.banana_parameter_axes()
+    assert alpha.default_value == banana.BANANA_ALPHA and kappa.default_value - 2 == banana.BANANA_KAPPA
+    assert kappa.labels()[0].replace("\u2212", "-").startswith("-1,5")
+    series = iu.banana_series(banana.BANANA_RANGE_STD, banana.BANANA_BEARING_STD)
+    comp = banana.banana_comparison()
+    assert series["ut_mx"][0] == comp.unscented.mean[0] and series["ut_my"][0] == comp.unscented.mean[1]
+    assert len(set(series["sig_x"])) <= 5

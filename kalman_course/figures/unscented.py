@@ -104,13 +104,13 @@ def ukf_orders():
 
 
 @register("ukf-cible-lointaine", chapter=CHAPTER,
-          title="Cible lointaine : erreur de position et NEES moyennes de l'EKF et de l'UKF (100 tirages)")
+          title="Cible lointaine : erreur de position et NEES moyennes de l'EKF, de l'UKF et de l'EKF itéré (100 tirages)")
 def ukf_distant_target():
     comp = distant_target_comparison()
     fig, (ax, an) = new_figure(2, 1, width=7.5, height=5.6, sharex=True)
-    for name, color in (("EKF", "tab:red"), ("UKF", "tab:blue")):
-        ax.semilogy(comp.t, comp.position_error[name], color=color, lw=1.6, label=name)
-        an.semilogy(comp.t, comp.nees[name], color=color, lw=1.6, label=name)
+    for name, color, ls in (("EKF", "tab:red", "-"), ("UKF", "tab:blue", "-"), ("EKF itéré", "tab:purple", "--")):
+        ax.semilogy(comp.t, comp.position_error[name], color=color, lw=1.6, ls=ls, label=name)
+        an.semilogy(comp.t, comp.nees[name], color=color, lw=1.6, ls=ls, label=name)
     lo, hi = chi2_band(4, comp.n_runs)
     an.axhspan(lo, hi, color="tab:green", alpha=0.2, label=f"bande à 95 % de la NEES moyenne ({comp.n_runs} tirages)")
     an.axhline(4.0, color="tab:green", lw=1.0)

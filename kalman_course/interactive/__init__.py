@@ -5,6 +5,8 @@
 - :func:`live_voltage_explorer` : curseurs ipywidgets (Φ, Ψ, P₀) qui relancent le filtre ; il faut un
   noyau (Jupyter, Binder, Colab).
 - :func:`tag_sliders`, :func:`live_tag_explorer` : les mêmes pour l'EKF du tag UWB (σₐ, σᵣ).
+- :func:`banana_uncertainty_sliders`, :func:`banana_parameter_sliders` : la « banane » de l'UKF (σθ, σᵣ ;
+  α, κ) ; :func:`particle_sliders` : le filtre particulaire (N, R).
 - :mod:`.grid` : les grilles précalculées (numpy seulement) ; :mod:`.sphinx_ext` : l'extension Sphinx
   qui sert BokehJS aux pages qui en ont besoin.
 
@@ -17,8 +19,13 @@ from .spec import Glyph, Panel
 from .static import StaticSliders
 from .tag import live_tag_explorer, tag_axes, tag_grid, tag_run, tag_sliders
 from .voltage import live_voltage_explorer, voltage_axes, voltage_grid, voltage_run, voltage_sliders
+from .unscented import banana_parameter_sliders, banana_uncertainty_sliders
+from .particle import particle_sliders
 
 __all__ = [
+    "banana_parameter_sliders",
+    "banana_uncertainty_sliders",
+    "particle_sliders",
     "Glyph",
     "LiveExplorer",
     "LogParameter",

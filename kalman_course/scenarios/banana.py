@@ -54,8 +54,8 @@ BANANA_RANGE = 1.0
 BANANA_BEARING = float(np.pi / 2)
 #: Écart-type de la distance (m).
 BANANA_RANGE_STD = 0.02
-#: Écart-type de l'azimut (rad) : 0,35 rad ≈ 20°.
-BANANA_BEARING_STD = 0.35
+#: Écart-type de l'azimut (rad) : 20° (0,349 rad).
+BANANA_BEARING_STD = float(np.deg2rad(20.0))
 #: Points sigma du chapitre : :math:`\alpha = 1`, :math:`\beta = 2`, :math:`\kappa = 3 - n = 1`.
 BANANA_ALPHA = 1.0
 BANANA_BETA = 2.0

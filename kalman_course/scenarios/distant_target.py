@@ -25,6 +25,7 @@ from ..core.results import freeze_fields
 from ..core.simulation import as_generator, check_positive_int
 from ..diagnostics.consistency import nees
 from ..filters.extended import extended_kalman_filter
+from ..filters.iterated import iterated_extended_kalman_filter
 from ..filters.unscented import unscented_kalman_filter
 from ._motion import simulate_cv
 from .radar import radar_tracking_model, range_bearing
@@ -103,7 +104,8 @@ def distant_target_run(rng: Any = TARGET_SEED, n_steps: int = TARGET_STEPS) -> D
 
 @dataclass(frozen=True, eq=False)
 class FilterComparison:
-    r"""Résultat de :func:`distant_target_comparison` : pour chaque filtre (clé ``"EKF"``, ``"UKF"``),
+    r"""Résultat de :func:`distant_target_comparison` : pour chaque filtre (clé ``"EKF"``, ``"UKF"``,
+    ``"EKF itéré"``),
     ``position_error[nom]`` (T,) erreur de position moyenne sur les tirages (m) et ``nees[nom]`` (T,) NEES
     moyenne (attendue : 4 = dimension de l'état) ; ``n_runs`` tirages ; ``t`` (T,) instants (s)."""
 
@@ -120,7 +122,7 @@ class FilterComparison:
 
 def distant_target_comparison(n_runs: int = TARGET_RUNS, rng: Any = TARGET_SEED,
                               n_steps: int = TARGET_STEPS) -> FilterComparison:
-    r"""EKF et UKF (:data:`TARGET_UKF`) sur ``n_runs`` tirages de :func:`distant_target_run` : erreur de
+    r"""EKF, UKF (:data:`TARGET_UKF`) et EKF itéré sur ``n_runs`` tirages de :func:`distant_target_run` : erreur de
     position et NEES moyennes à chaque pas."""
     n_runs = check_positive_int("n_runs", n_runs)
     gen = as_generator(rng)
@@ -128,6 +130,7 @@ def distant_target_comparison(n_runs: int = TARGET_RUNS, rng: Any = TARGET_SEED,
     filters = {
         "EKF": lambda run: extended_kalman_filter(model, run.y, run.x0, run.P0),
         "UKF": lambda run: unscented_kalman_filter(model, run.y, run.x0, run.P0, **TARGET_UKF),
+        "EKF itéré": lambda run: iterated_extended_kalman_filter(model, run.y, run.x0, run.P0),
     }
     err = {name: np.zeros(n_steps) for name in filters}
     eps = {name: np.zeros(n_steps) for name in filters}
