@@ -336,5 +336,7 @@ def test_particle_sliders_default_position_is_the_chapter_run():
     run = ip.particle_run(axes[0].default_value, axes[1].default_value)
     bench = convergence.linear_benchmark()
     pf = kc.particle_filter(bench.nonlinear, bench.y, bench.x0, bench.P0, n_particles=1000, rng=ip.PF_SEED)
-    np.testing.assert_array_equal(run["pf"], pf.x[:, 0])
+    kf = kc.kalman_filter(bench.model, bench.y, bench.x0, bench.P0)
+    np.testing.assert_array_equal(run["gap"], pf.x[:, 0] - kf.x[:, 0])
+    assert axes[0].labels()[-1] == "10\u202f000"
     np.testing.assert_array_equal(run["ess"], pf.ess / 1000)

@@ -8,7 +8,7 @@ import scipy.stats
 from ..filters.particle import RESAMPLING_SCHEMES
 from ..numbers import format_number
 from ..scenarios import growth
-from ..scenarios.convergence import loglog_slope, particle_convergence
+from ..scenarios.convergence import particle_convergence
 from ..scenarios.importance import degeneracy, importance_example
 from ._registry import new_figure, register
 
@@ -147,8 +147,7 @@ def pf_convergence():
               label=f"moyenne : ‖x̂ − x̂_KF‖ (pente {format_number(conv.mean_slope, decimals=2)})")
     ax.loglog(N, conv.cov_error, "s-", color="tab:orange",
               label=f"covariance : ‖P − P_KF‖ (pente {format_number(conv.cov_slope, decimals=2)})")
-    ax.loglog(N, conv.loglik_error, "^-", color="tab:green",
-              label=f"log-vraisemblance (nats, pente {format_number(loglog_slope(N, conv.loglik_error), decimals=2)})")
+    ax.loglog(N, conv.loglik_error, "^-", color="tab:green", label="log-vraisemblance (nats)")
     ax.loglog(N, conv.mean_error[0] * np.sqrt(N[0] / N), "k:", label="pente −1/2")
     ax.set_xlabel("nombre de particules N")
     ax.set_ylabel("écart quadratique moyen (unités de l'état)")

@@ -72,18 +72,20 @@ def banana_series(range_std: float, bearing_std: float, *, alpha: float = banana
     return out
 
 
-def _panel(title: str, with_cloud: bool = True) -> Panel:
-    glyphs = [Glyph("cloud_y", "scatter", "silver", "tirages g(r, θ)", x="cloud_x")] if with_cloud else []
-    glyphs += [
-        Glyph("truth_y", "line", "black", "vérité (2σ)", x="truth_x"),
-        Glyph("lin_y", "line", "firebrick", "linéarisation, EKF (2σ)", x="lin_x"),
-        Glyph("ut_y", "line", "royalblue", "sans parfum, UKF (2σ)", x="ut_x"),
-        Glyph("truth_my", "scatter", "black", "moyenne vraie", x="truth_mx"),
-        Glyph("lin_my", "scatter", "firebrick", "moyenne EKF", x="lin_mx"),
-        Glyph("ut_my", "scatter", "royalblue", "moyenne UKF", x="ut_mx"),
-        Glyph("sig_y", "scatter", "navy", "images des points sigma", x="sig_x"),
+def _panel(title: str, method: str, y_range: tuple[float, float]) -> Panel:
+    """Un panneau : nuage et vérité (ellipse à 2σ, moyenne), puis la méthode ``"lin"`` (EKF) ou ``"ut"``
+    (UKF, avec les images des points sigma). Légendes courtes : elles tiennent sur une ligne."""
+    name, color = ("EKF", "firebrick") if method == "lin" else ("UKF", "royalblue")
+    glyphs = [
+        Glyph("cloud_y", "scatter", "silver", "tirages", x="cloud_x"),
+        Glyph("truth_y", "line", "black", "vraie", x="truth_x"),
+        Glyph("truth_my", "scatter", "black", "moy. vraie", x="truth_mx"),
+        Glyph(f"{method}_y", "line", color, name, x=f"{method}_x"),
+        Glyph(f"{method}_my", "scatter", color, f"moy. {name}", x=f"{method}_mx"),
     ]
-    return Panel(title, "y (m)", tuple(glyphs), x_label="x (m)", x_range=(-1.15, 1.15), y_range=(-0.25, 1.45),
+    if method == "ut":
+        glyphs.append(Glyph("sig_y", "scatter", "navy", "points σ", x="sig_x"))
+    return Panel(title, "y (m)", tuple(glyphs), x_label="x (m)", x_range=(-1.1, 1.1), y_range=y_range,
                  equal_aspect=True)
 
 
@@ -117,10 +119,14 @@ def banana_uncertainty_sliders():
         return banana_series(range_std, float(np.deg2rad(bearing_deg)))
 
     grid = precompute_grid(run, *banana_uncertainty_axes(), time=np.arange(N_POINTS, dtype=float))
+    panels = (
+        _panel("Linéarisation (EKF) contre vérité — ellipses à 2σ", "lin", (-0.1, 1.35)),
+        _panel("Transformée sans parfum (UKF) contre vérité — ellipses à 2σ", "ut", (-0.1, 1.35)),
+    )
     return StaticSliders(
-        grid, (_panel("Loi polaire vue en cartésien (r = 1 m, θ = 90°)"),), x_label="x (m)",
+        grid, panels, x_label="x (m)",
         name="ukf-banane-incertitude",
-        title="La banane : déplacez les incertitudes d'azimut et de distance",
+        title="La banane (r = 1 m, θ = 90°) : déplacez les incertitudes d'azimut et de distance",
     )
 
 
@@ -136,7 +142,7 @@ def banana_parameter_sliders():
     grid = precompute_grid(run, *banana_parameter_axes(), time=np.arange(N_POINTS, dtype=float))
     sample = banana.banana_sample(N_POINTS)
     return StaticSliders(
-        grid, (_panel("Transformée sans parfum : points sigma et poids", with_cloud=True),), x_label="x (m)",
+        grid, (_panel("Transformée sans parfum (UKF) contre vérité — ellipses à 2σ", "ut", (0.35, 1.3)),), x_label="x (m)",
         fixed={"cloud_x": sample[:, 0], "cloud_y": sample[:, 1]},
         name="ukf-banane-parametres",
         title="Les paramètres des points sigma : α et κ (σθ = 20°, σᵣ = 2 cm)",
