@@ -22,7 +22,7 @@ def enkf_convergence():
     ax.loglog(N, conv.cov_error, "s-", color="tab:orange",
               label=f"covariance : ‖P − P_KF‖ (pente {format_number(conv.cov_slope, decimals=2)})")
     ax.loglog(N, conv.mean_error[0] * np.sqrt(N[0] / N), "k:", label="pente −1/2")
-    ax.set_xlabel("taille de l'ensemble N")
+    ax.set_xlabel("taille de l’ensemble N (sans unité)")
     ax.set_ylabel("écart quadratique moyen (unités de l'état)")
     ax.set_title(f"Banc d'essai linéaire, {conv.n_runs} graines par N", fontsize=10)
     ax.grid(alpha=0.3, which="both")
@@ -39,7 +39,7 @@ def enkf_perturbations():
     ax.plot(t, s.kalman, "k-", lw=2, label="filtre de Kalman : P_k|k (exacte)")
     ax.plot(t, s.perturbed, color="tab:blue", lw=1.4, label="EnKF, observations perturbées")
     ax.plot(t, s.unperturbed, color="tab:red", lw=1.4, ls="--", label="EnKF sans perturbations")
-    ax.set_xlabel("pas k")
+    ax.set_xlabel("pas de temps k")
     ax.set_ylabel("variance de position (m²)")
     ax.set_ylim(0, None)
     ax.set_title("Dispersion de l'ensemble analysé (200 membres)", fontsize=10)

@@ -54,7 +54,7 @@ def pf_degeneracy():
     ax.semilogy(t, d.with_, "o-", ms=3, color="tab:blue", label="avec rééchantillonnage quand ESS < N/2 (τ = 0,5)")
     ax.axhline(0.5, color="tab:blue", lw=0.8, ls=":")
     ax.axhline(1.0 / d.n_particles, color="k", lw=0.8, ls="--", label="une seule particule (ESS = 1)")
-    ax.set_xlabel("pas k")
+    ax.set_xlabel("pas de temps k")
     ax.set_ylabel("ESS / N (sans unité)")
     ax.set_title(f"{format_number(d.n_particles, decimals=0)} particules, banc d'essai linéaire", fontsize=10)
     ax.grid(alpha=0.3, which="both")
@@ -88,7 +88,8 @@ def pf_resampling():
     ax.set_yticks([3, 2, 1], [names[r[0]] for r in rows])
     ax.set_xlim(0, 1.35)
     ax.set_xticks(np.linspace(0, 1, 5))
-    ax.set_xlabel("somme cumulée des poids (sans unité) ; ▼ positions uₖ ; pointillés : strates k/N")
+    ax.set_xlabel("somme cumulée des poids ; ▼ : positions ; pointillés : strates k/N (sans unité)")
+    ax.set_ylabel("schéma (sans unité)")
     ax.set_title(f"{N} particules : la particule i est copiée autant de fois que de positions tombent dans son segment",
                  fontsize=9)
     return fig
@@ -112,7 +113,7 @@ def pf_growth():
         ax.plot(data.t, runs[name].x[:, 0], ls, color=color, lw=1.3,
                 label=f"{name} (erreur quadratique moyenne {format_number(rmse[name], decimals=1)})")
     ax.set_ylabel("état x (sans unité)")
-    ax.set_xlabel("pas k")
+    ax.set_xlabel("pas de temps k")
     ax.legend(fontsize=7, loc="lower left", ncol=2)
     ax.grid(alpha=0.3)
     ax.set_title("Particules (points bleus, opacité ∝ poids) : souvent deux groupes, en ±x", fontsize=10)
@@ -149,7 +150,7 @@ def pf_convergence():
               label=f"covariance : ‖P − P_KF‖ (pente {format_number(conv.cov_slope, decimals=2)})")
     ax.loglog(N, conv.loglik_error, "^-", color="tab:green", label="log-vraisemblance (nats)")
     ax.loglog(N, conv.mean_error[0] * np.sqrt(N[0] / N), "k:", label="pente −1/2")
-    ax.set_xlabel("nombre de particules N")
+    ax.set_xlabel("nombre de particules N (sans unité)")
     ax.set_ylabel("écart quadratique moyen (unités de l'état)")
     ax.set_title(f"Banc d'essai linéaire, {conv.n_runs} graines par N", fontsize=10)
     ax.grid(alpha=0.3, which="both")
