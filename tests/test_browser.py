@@ -37,7 +37,14 @@ CHROMIUM_ARGS = [
 # page_errors vérifie qu'il n'en reste qu'une.)
 
 #: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet).
-EXPECTED_GRIDS = {"tension-curseurs": ki.voltage_grid, "tag-curseurs": ki.tag_grid}
+EXPECTED_GRIDS = {
+    "tension-curseurs": ki.voltage_grid,
+    "tag-curseurs": ki.tag_grid,
+    # chapitres « UKF » et « filtre particulaire »
+    "ukf-banane-incertitude": ki.banana_uncertainty_grid,
+    "ukf-banane-parametres": ki.banana_parameter_grid,
+    "filtre-particulaire-curseurs": ki.particle_grid,
+}
 
 
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):

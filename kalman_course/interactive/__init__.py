@@ -19,12 +19,20 @@ from .spec import Glyph, Panel
 from .static import StaticSliders
 from .tag import live_tag_explorer, tag_axes, tag_grid, tag_run, tag_sliders
 from .voltage import live_voltage_explorer, voltage_axes, voltage_grid, voltage_run, voltage_sliders
-from .unscented import banana_parameter_sliders, banana_uncertainty_sliders
-from .particle import particle_sliders
+from .unscented import (
+    banana_parameter_grid,
+    banana_parameter_sliders,
+    banana_uncertainty_grid,
+    banana_uncertainty_sliders,
+)
+from .particle import particle_grid, particle_sliders
 
 __all__ = [
+    "banana_parameter_grid",
     "banana_parameter_sliders",
+    "banana_uncertainty_grid",
     "banana_uncertainty_sliders",
+    "particle_grid",
     "particle_sliders",
     "Glyph",
     "LiveExplorer",

@@ -18,10 +18,10 @@ from ..filters.kalman import kalman_filter
 from ..numbers import format_integer
 from ..filters.particle import particle_filter
 from ..scenarios.convergence import LINEAR_STEPS, linear_benchmark
-from .grid import ParameterAxis, precompute_grid
+from .grid import ParameterAxis, ParameterGrid, precompute_grid
 from .spec import Glyph, Panel
 
-__all__ = ["PF_SEED", "particle_axes", "particle_run", "particle_sliders"]
+__all__ = ["PF_SEED", "particle_axes", "particle_run", "particle_grid", "particle_sliders"]
 
 #: Graine du filtre particulaire (la même pour toutes les positions des curseurs).
 PF_SEED = 1
@@ -57,11 +57,16 @@ def particle_run(n_particles: float, R: float) -> dict[str, np.ndarray]:
     return {"gap": pf.x[:, 0] - kf.x[:, 0], "lo": -s, "hi": s, "ess": pf.ess / N}
 
 
+def particle_grid() -> ParameterGrid:
+    r"""Toutes les positions :math:`(N, R)` (séries de :func:`particle_run`)."""
+    return precompute_grid(particle_run, *particle_axes(), time=np.arange(1, LINEAR_STEPS + 1, dtype=float))
+
+
 def particle_sliders():
     """Figure à curseurs statiques :math:`N` et :math:`R` (Bokeh)."""
     from .static import StaticSliders
 
-    grid = precompute_grid(particle_run, *particle_axes(), time=np.arange(1, LINEAR_STEPS + 1, dtype=float))
+    grid = particle_grid()
     panels = (
         Panel(
             "Écart de l'estimation du filtre particulaire à la réponse exacte (filtre de Kalman)",

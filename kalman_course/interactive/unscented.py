@@ -20,7 +20,7 @@ import numpy as np
 
 from ..figures._geometry import ellipse_points
 from ..scenarios import banana
-from .grid import ParameterAxis, format_value, precompute_grid
+from .grid import ParameterAxis, ParameterGrid, format_value, precompute_grid
 from .spec import Glyph, Panel
 
 __all__ = [
@@ -28,6 +28,8 @@ __all__ = [
     "banana_series",
     "banana_uncertainty_axes",
     "banana_parameter_axes",
+    "banana_uncertainty_grid",
+    "banana_parameter_grid",
     "banana_uncertainty_sliders",
     "banana_parameter_sliders",
 ]
@@ -111,14 +113,31 @@ def banana_parameter_axes() -> tuple[ParameterAxis, ParameterAxis]:
     )
 
 
-def banana_uncertainty_sliders():
-    r"""Figure à curseurs statiques :math:`\sigma_\theta`, :math:`\sigma_r` (Bokeh)."""
-    from .static import StaticSliders
+def banana_uncertainty_grid() -> ParameterGrid:
+    r"""Toutes les positions :math:`(\sigma_\theta, \sigma_r)` (séries de :func:`banana_series`)."""
 
     def run(bearing_deg: float, range_std: float):
         return banana_series(range_std, float(np.deg2rad(bearing_deg)))
 
-    grid = precompute_grid(run, *banana_uncertainty_axes(), time=np.arange(N_POINTS, dtype=float))
+    return precompute_grid(run, *banana_uncertainty_axes(), time=np.arange(N_POINTS, dtype=float))
+
+
+def banana_parameter_grid() -> ParameterGrid:
+    r"""Toutes les positions :math:`(\alpha, \kappa)` à :math:`\sigma_\theta = 20°`, :math:`\sigma_r = 2` cm
+    (séries de :func:`banana_series`, sans le nuage, qui ne dépend pas des curseurs)."""
+
+    def run(alpha: float, n_plus_kappa: float):
+        return banana_series(banana.BANANA_RANGE_STD, banana.BANANA_BEARING_STD, alpha=alpha,
+                             kappa=n_plus_kappa - _N, cloud=False)
+
+    return precompute_grid(run, *banana_parameter_axes(), time=np.arange(N_POINTS, dtype=float))
+
+
+def banana_uncertainty_sliders():
+    r"""Figure à curseurs statiques :math:`\sigma_\theta`, :math:`\sigma_r` (Bokeh)."""
+    from .static import StaticSliders
+
+    grid = banana_uncertainty_grid()
     panels = (
         _panel("Linéarisation (EKF) contre vérité — ellipses à 2σ", "lin", (-0.1, 1.35)),
         _panel("Transformée sans parfum (UKF) contre vérité — ellipses à 2σ", "ut", (-0.1, 1.35)),
@@ -135,11 +154,7 @@ def banana_parameter_sliders():
     :math:`\sigma_r = 2` cm."""
     from .static import StaticSliders
 
-    def run(alpha: float, n_plus_kappa: float):
-        return banana_series(banana.BANANA_RANGE_STD, banana.BANANA_BEARING_STD, alpha=alpha,
-                             kappa=n_plus_kappa - _N, cloud=False)
-
-    grid = precompute_grid(run, *banana_parameter_axes(), time=np.arange(N_POINTS, dtype=float))
+    grid = banana_parameter_grid()
     sample = banana.banana_sample(N_POINTS)
     return StaticSliders(
         grid, (_panel("Transformée sans parfum (UKF) contre vérité — ellipses à 2σ", "ut", (0.35, 1.3)),), x_label="x (m)",
