@@ -78,12 +78,13 @@ def particle_sliders():
                 Glyph("gap", "line", "darkorange", "filtre particulaire − filtre de Kalman"),
             ),
             height=260,
+            y_range=(-4.0, 4.0),
         ),
         Panel("Taille effective de l'échantillon après chaque mesure", "ESS / N (sans unité)",
               (Glyph("ess", "line", "darkorange", "ESS / N"),), y_log=True, y_range=(1e-3, 1.0)),
     )
     return StaticSliders(
-        grid, panels, x_label="pas k",
+        grid, panels, x_label="pas de temps k",
         name="filtre-particulaire-curseurs",
         title="Filtre particulaire : nombre de particules N et variance de mesure R",
     )
