@@ -42,7 +42,15 @@ CHROMIUM_ARGS = [
 # page_errors vérifie qu'il n'en reste qu'une.)
 
 #: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet).
-EXPECTED_GRIDS = {"tension-curseurs": ki.voltage_grid, "tag-curseurs": ki.tag_grid, "nil-curseurs": ki.nile_grid}
+EXPECTED_GRIDS = {
+    "tension-curseurs": ki.voltage_grid,
+    "tag-curseurs": ki.tag_grid,
+    "nil-curseurs": ki.nile_grid,
+    # chapitres « UKF » et « filtre particulaire »
+    "ukf-banane-incertitude": ki.banana_uncertainty_grid,
+    "ukf-banane-parametres": ki.banana_parameter_grid,
+    "filtre-particulaire-curseurs": ki.particle_grid,
+}
 
 
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):
@@ -155,7 +163,7 @@ _PROSE = r"""() => {
     if (el.closest('a') && /^\s*(https?:|www\.|doi:)/i.test(t)) continue;  // une adresse affichée
     scan(/\$\$|\\\(|\\\)|\\\[|\\\]|\\[a-zA-Z]{2,}|\{glue|\{eq\}|\{doc\}/g, t, out.tex);
     // 0.5, -3.25, 1.2e-05, 3e+02 ; pas 2.0.0 (version), 10.1115/… (DOI), 1:30, a.b
-    scan(/(?<![\w.,\/:\u2212-])[-\u2212]?\d+\.\d+(?![\w\/]|\.\d)|(?<![\w.])\d+(?:\.\d+)?e[-+]?\d+(?!\w)/g, t, out.english);
+    scan(/(?<![\w.,\/:\u2212-])(?<!§[\s\u00a0\u202f]?)[-\u2212]?\d+\.\d+(?![\w\/]|\.\d)|(?<![\w.])\d+(?:\.\d+)?e[-+]?\d+(?!\w)/g, t, out.english);
     scan(/[ \t\n\r](?=[:;!?](?![\w\/]))/g, t, out.space);
     scan(/«(?![\u00a0\u202f])|(?<![\u00a0\u202f])»/g, t, out.guillemets);
   }
@@ -412,7 +420,7 @@ def test_prose_checks_flag_prose_only(browser):
     NB, NN = "\u00a0", "\u202f"
     good = (f"<p>Le gain{NB}: 0,5{NN}; la «{NB}recette{NB}»{NN}? À 10:30, voir "
             f"<a href='https://example.org/a:b'>https://example.org/a:b</a>, doi:10.1115/1.3662552, "
-            f"filterpy 2.0.0.</p><pre>x = 0.5 ; print('a : b')</pre><code>1e-05 :</code>"
+            f"filterpy 2.0.0, Durbin et Koopman (§{NB}5.2).</p><pre>x = 0.5 ; print('a : b')</pre><code>1e-05 :</code>"
             f"<span class='math'>\\frac{{a}}{{b}} : 0.5</span>")
     bad = ("<p>Le gain : 0.5 ; la « recette » ? Écart 1.2e-05 et \\frac{a}{b}.</p>"
            "<div class='cell_input'><pre>kc.numbers.glue_number('x', 1.0)</pre></div>"

@@ -412,4 +412,4 @@ def test_static_sliders_print_the_default_run_with_a_caption():
     np.testing.assert_allclose(plotted["Pₙ (a posteriori)"], expected["P"], rtol=0, atol=1e-15)
     np.testing.assert_allclose(plotted["gain Kₙ"], expected["K"], rtol=0, atol=1e-15)
     caption = figure.caption()
-    assert "Φ = 1·10⁻⁵ V²" in caption and "Ψ = 0,01 V²" in caption and "15 × 15" in caption
+    assert "Φ = 1\u202f×\u202f10⁻⁵\u00a0V²" in caption and "Ψ = 0,01\u00a0V²" in caption and "15 × 15" in caption

@@ -273,10 +273,10 @@ def test_result_of_another_model_is_refused():
 
 
 def test_result_of_another_filter_is_refused():
-    """Le résultat de l'UKF (filterpy) n'est pas celui de l'EKF : prédictions différentes."""
+    """Le résultat de l'UKF n'est pas celui de l'EKF : prédictions différentes."""
     data = kc.scenarios.tag_data(n_steps=40)
     model = kc.scenarios.tag_model()
-    ukf = kc.filterpy_unscented_filter(kc.scenarios.tag_model(), data.y, data.x0, data.P0)
+    ukf = kc.unscented_kalman_filter(kc.scenarios.tag_model(), data.y, data.x0, data.P0, alpha=0.1, kappa=-1.0)
     ekf = kc.extended_kalman_filter(model, data.y, data.x0, data.P0)
     kc.extended_rts_smoother(model, ekf)  # accepté
     with pytest.raises(kc.KalmanInputError, match="ne vient pas du filtre de Kalman étendu"):
@@ -398,3 +398,52 @@ def test_target_scenario_claims():
     k = g0 + int(np.argmax(sd_s[g0:g1]))
     assert g0 + 5 <= k <= g1 - 5  # lentille : maximum loin des bords
     assert sd_s[-1] == sd_f[-1]
+
+
+# --------------------------------------------------------------------------- lisseur RTS sans parfum
+
+
+@pytest.mark.parametrize("alpha, beta, kappa", [(0.1, 2.0, -1.0), (1.0, 2.0, 0.0), (0.5, 0.0, 3.0)])
+def test_unscented_smoother_equals_filterpy_rts_smoother(alpha, beta, kappa):
+    """Tag UWB : le lisseur sans parfum du paquet contre ``UnscentedKalmanFilter.rts_smoother`` de filterpy,
+    appliqué aux mêmes estimations filtrées."""
+    from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
+
+    data = kc.scenarios.tag_data(n_steps=120)
+    model = kc.scenarios.tag_model()
+    res = kc.unscented_kalman_filter(model, data.y, data.x0, data.P0, alpha=alpha, beta=beta, kappa=kappa)
+    ours = kc.unscented_rts_smoother(model, res, alpha=alpha, beta=beta, kappa=kappa)
+    points = MerweScaledSigmaPoints(4, alpha=alpha, beta=beta, kappa=kappa)
+    ukf = UnscentedKalmanFilter(dim_x=4, dim_z=4, dt=1.0, hx=lambda x: model.observe(np.asarray(x)),
+                                fx=lambda x, dt: model.transition(np.asarray(x), None), points=points)
+    ukf.Q = np.array(model.Q)
+    xs, Ps, Ks = ukf.rts_smoother(np.array(res.x), np.array(res.P))
+    np.testing.assert_allclose(ours.x, xs, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(ours.P, Ps, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(ours.G[:-1], Ks[:-1], rtol=0, atol=1e-9)
+    # le lissage sert : erreur de position plus petite que celle du filtre
+    err_f = np.linalg.norm(res.x[20:, :2] - data.x_true[20:, :2], axis=1).mean()
+    err_s = np.linalg.norm(ours.x[20:, :2] - data.x_true[20:, :2], axis=1).mean()
+    assert err_s < 0.8 * err_f
+
+
+def test_unscented_smoother_on_a_linear_model_is_the_rts_smoother():
+    model, y, u, x0, P0, _ = _data(31, 3, 2, 0)
+    lin = kc.unscented_kalman_filter(kc.NonlinearModel.from_linear(model), y, x0, P0, alpha=1.0, beta=2.0, kappa=0.0)
+    ours = kc.unscented_rts_smoother(kc.NonlinearModel.from_linear(model), lin, alpha=1.0, beta=2.0, kappa=0.0)
+    ref = kc.rts_smoother(model, kc.kalman_filter(model, y, x0, P0))
+    np.testing.assert_allclose(ours.x, ref.x, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(ours.P, ref.P, rtol=1e-9, atol=1e-9)
+
+
+def test_unscented_smoother_refuses_other_parameters_or_filters():
+    """Pendule (dynamique non linéaire) : une prédiction faite avec d'autres paramètres ou par l'EKF se voit."""
+    data = kc.scenarios.pendulum.pendulum_data(n_steps=200)
+    model = kc.scenarios.pendulum.pendulum_model()
+    res = kc.unscented_kalman_filter(model, data.y, data.x0, data.P0, alpha=0.5, kappa=0.0)
+    kc.unscented_rts_smoother(model, res, alpha=0.5, kappa=0.0)  # accepté
+    with pytest.raises(kc.KalmanInputError, match="ne vient pas du filtre de Kalman sans parfum"):
+        kc.unscented_rts_smoother(model, res, alpha=0.1, kappa=-1.0)
+    ekf = kc.extended_kalman_filter(model, data.y, data.x0, data.P0)
+    with pytest.raises(kc.KalmanInputError, match="ne vient pas du filtre de Kalman sans parfum"):
+        kc.unscented_rts_smoother(model, ekf, alpha=0.5, kappa=0.0)

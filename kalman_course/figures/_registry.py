@@ -26,7 +26,11 @@ CHAPTER_TITLES: dict[str, str] = {
     "ekf": "Dynamique non linéaire — le filtre de Kalman étendu",
     "suivi-tag": "Exemple — suivi d'un tag radio (UWB)",
     "ekf-itere": "Filtre de Kalman étendu itéré",
-    "pour-aller-plus-loin": "Pour aller plus loin : le filtre de Kalman « unscented »",
+    "ukf": "Le filtre de Kalman sans parfum (UKF)",
+    "filtre-particulaire": "Le filtre particulaire",
+    "enkf": "Le filtre de Kalman d'ensemble (EnKF)",
+    "lissage": "Lissage : le lisseur de Rauch–Tung–Striebel",
+    "vraisemblance": "Apprendre Q et R : vraisemblance et données réelles",
     "srif": "Filtre d'information en racine carrée (SRIF)",
     "ekf-itere-se3": "EKF itéré sur SE(3) : pose d'une cible vue par une caméra",
 }

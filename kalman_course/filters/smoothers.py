@@ -22,7 +22,9 @@ ne demande rien de particulier ; la commande est déjà dans les prédictions
 * :func:`rts_smoother` lisse un résultat de :func:`~kalman_course.kalman_filter` (:math:`A`) ou de
   :func:`~kalman_course.filters.diffuse.diffuse_kalman_filter` (départ diffus exact) ;
 * :func:`extended_rts_smoother` lisse un résultat de l'EKF (ou de l'EKF itéré) : :math:`A` devient la
-  jacobienne :math:`F_k = \partial f/\partial x` en :math:`(\hat x_{k\mid k}, u)`, la prédiction du filtre.
+  jacobienne :math:`F_k = \partial f/\partial x` en :math:`(\hat x_{k\mid k}, u)`, la prédiction du filtre ;
+* :func:`unscented_rts_smoother` lisse un résultat de l'UKF (Särkkä, 2008) : la covariance croisée
+  :math:`C_{k,k+1}` des points sigma remplace :math:`P_{k\mid k}F_k^T`.
 
 Les deux vérifient que le résultat vient bien du filtre de ce modèle (prédictions
 :math:`P_{k+1\mid k} = F_kP_{k\mid k}F_k^T + Q` et :math:`S_k = CP_{k\mid k-1}C^T + R` retrouvées) :
@@ -48,8 +50,8 @@ from ..core.validation import KalmanInputError, as_controls, as_gaussian, check_
 from .diffuse import DiffuseFilterResult, is_determined
 from .extended import NONLINEAR_HINT
 
-__all__ = ["SmootherResult", "rts_smoother", "extended_rts_smoother", "smoother_gains", "rts_pass",
-           "CONSISTENCY_RTOL"]
+__all__ = ["SmootherResult", "rts_smoother", "extended_rts_smoother", "unscented_rts_smoother", "smoother_gains",
+           "rts_pass", "CONSISTENCY_RTOL"]
 
 #: Tolérance relative de la vérification « ce résultat vient du filtre de ce modèle ».
 CONSISTENCY_RTOL = 1e-6
@@ -434,3 +436,54 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
         *initial, lag[0] = _smooth_initial(x0_arr, P0_arr, F0, model.process_noise(x0_arr, control(0)),
                                            model.transition(x0_arr, control(0)), result, xs[0], Ps[0])
     return SmootherResult(xs, Ps, G, lag, *initial, method="RTS étendu")
+
+
+def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha: float, beta: float = 2.0,
+                           kappa: float = 0.0, u: Any = None) -> SmootherResult:
+    r"""Lisseur RTS « sans parfum » (Särkkä, 2008) pour un résultat de
+    :func:`~kalman_course.unscented_kalman_filter`, avec les mêmes paramètres :math:`(\alpha, \beta, \kappa)`.
+
+    Pour :math:`k = T-2, \dots, 0` : points sigma :math:`\chi_i` de :math:`(\hat x_{k\mid k}, P_{k\mid k})`,
+    images :math:`\chi_i^f = f(\chi_i, u_{k+1})`, puis
+
+    .. math::
+
+        \bar x = \sum_i W^m_i\chi_i^f,\quad
+        \bar P = \sum_i W^c_i(\chi_i^f - \bar x)(\chi_i^f - \bar x)^T + Q,\quad
+        C = \sum_i W^c_i(\chi_i - \hat x_{k\mid k})(\chi_i^f - \bar x)^T,
+
+        G_k = C\bar P^{-1},\quad
+        \hat x_{k\mid T} = \hat x_{k\mid k} + G_k(\hat x_{k+1\mid T} - \bar x),\quad
+        P_{k\mid T} = P_{k\mid k} + G_k(P_{k+1\mid T} - \bar P)G_k^T .
+
+    :math:`(\bar x, \bar P)` est la prédiction de l'UKF : on vérifie qu'elle redonne celle du résultat
+    (même modèle, même filtre, mêmes paramètres). Sur un modèle linéaire avec :math:`\alpha = 1`,
+    :math:`\beta = 2`, :math:`\kappa = 0`, c'est :func:`rts_smoother`. ``G`` (T, n, n), ``P_lag`` comme
+    :func:`rts_smoother`. Paramètres : ``u`` (T, p) : les commandes données au filtre.
+    """
+    from .unscented import _points, sigma_weights
+
+    model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
+    result = _check_result(result)
+    n, m, T = model.n_state, model.n_obs, result.n_steps
+    _check_dimensions(result, n, m)
+    _check_finite(result)
+    U = as_controls("u", u, T, model.n_control)
+    Wm, Wc, lam = sigma_weights(n, alpha=alpha, beta=beta, kappa=kappa)
+    x, P = result.x, result.P
+    xb = np.empty((max(T - 1, 0), n))
+    Pb = np.empty((max(T - 1, 0), n, n))
+    G = np.zeros_like(P)
+    for k in range(T - 1):
+        X = _points(x[k], P[k], n + lam, f"lissage du pas {k}", "filtrée P")
+        Xf = model.transition_many(X, None if U is None else U[k + 1])
+        xb[k] = Wm.dot(Xf)
+        D = Xf - xb[k]
+        Pb[k] = symmetrize(D.T.dot(Wc[:, None] * D) + model.Q)
+        C = (X - x[k]).T.dot(Wc[:, None] * D)
+        G[k] = np.linalg.solve(Pb[k], C.T).T  # G = C P̄⁻¹, P̄ symétrique
+    _check_consistency(result, Pb, xb, None, None, "filtre de Kalman sans parfum",
+                       ", les mêmes paramètres (alpha, beta, kappa) et les mêmes commandes « u » "
+                       "(unscented_rts_smoother lisse la sortie d'unscented_kalman_filter)")
+    xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
+    return SmootherResult(xs, Ps, G, lag, method="RTS sans parfum")

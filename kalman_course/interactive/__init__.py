@@ -6,6 +6,8 @@
   noyau (Jupyter, Binder, Colab).
 - :func:`tag_sliders`, :func:`live_tag_explorer` : les mêmes pour l'EKF du tag UWB (σₐ, σᵣ).
 - :func:`nile_sliders`, :func:`live_nile_explorer` : le Nil filtré et lissé (R, Q), chapitre « Lissage ».
+- :func:`banana_uncertainty_sliders`, :func:`banana_parameter_sliders` : la « banane » de l'UKF (σθ, σᵣ ;
+  α, κ) ; :func:`particle_sliders` : le filtre particulaire (N, R).
 - :mod:`.grid` : les grilles précalculées (numpy seulement) ; :mod:`.sphinx_ext` : l'extension Sphinx
   qui sert BokehJS aux pages qui en ont besoin.
 
@@ -19,8 +21,21 @@ from .static import StaticSliders
 from .smoothing import live_nile_explorer, nile_axes, nile_grid, nile_slider_run, nile_sliders
 from .tag import live_tag_explorer, tag_axes, tag_grid, tag_run, tag_sliders
 from .voltage import live_voltage_explorer, voltage_axes, voltage_grid, voltage_run, voltage_sliders
+from .unscented import (
+    banana_parameter_grid,
+    banana_parameter_sliders,
+    banana_uncertainty_grid,
+    banana_uncertainty_sliders,
+)
+from .particle import particle_grid, particle_sliders
 
 __all__ = [
+    "banana_parameter_grid",
+    "banana_parameter_sliders",
+    "banana_uncertainty_grid",
+    "banana_uncertainty_sliders",
+    "particle_grid",
+    "particle_sliders",
     "Glyph",
     "LiveExplorer",
     "LogParameter",
