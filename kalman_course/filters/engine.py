@@ -30,6 +30,7 @@ d'entrée sont donc les mêmes pour tous les filtres.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, Callable, NamedTuple
 
 import numpy as np
@@ -131,26 +132,39 @@ def run_filter(
     Y = as_measurements("y", y, m)
     T = Y.shape[0]
     U = as_controls("u", u, T, model.n_control)
-    state = family.prior(model, x0, P0, **draws)
+    prior, predict, update = family.prior, family.predict, family.update
+    if draws:  # le générateur lié une fois pour toutes, pas à chaque appel
+        prior, predict, update = (partial(f, **draws) for f in (prior, predict, update))
+    state = prior(model, x0, P0)
     observed = observed_rows(Y)
     out = FilterHistory(T, family.state_shape(model), family.tangent_dim(model), m, observed)
     full = observed.all(axis=1)
     some = observed.any(axis=1)
     extras: dict[str, list] = {}
+    # boucle chaude : références locales, pas d'appel superflu (moments identiques pour les filtres gaussiens)
+    moments = None if family.moments is gaussian_moments else family.moments
+    step_outputs = family.step_outputs
+    xs, Ps, xps, Pps = out.x, out.P, out.x_pred, out.P_pred
+    Ks, nus, Ss, n_iter = out.K, out.innovation, out.S, out.n_iter
     for k in range(T):
-        predicted = family.predict(model, state, None if U is None else U[k], **draws)
+        predicted = predict(model, state, None if U is None else U[k])
         if full[k]:
-            state, corr = family.update(model, predicted, Y[k], None, **draws)
-            out.correction(k, corr)
+            state, corr = update(model, predicted, Y[k], None)
+            Ks[k], nus[k], Ss[k], n_iter[k] = corr
         elif some[k]:
             idx = np.flatnonzero(observed[k])
-            state, corr = family.update(model, predicted, Y[k, idx], idx, **draws)
+            state, corr = update(model, predicted, Y[k, idx], idx)
             out.correction(k, corr, idx)
         else:
             state = predicted
-        out.store(k, *family.moments(predicted), *family.moments(state))
-        if family.step_outputs is not None:
-            for name, value in family.step_outputs(state).items():
+        if moments is None:
+            xps[k], Pps[k] = predicted
+            xs[k], Ps[k] = state
+        else:
+            xps[k], Pps[k] = moments(predicted)
+            xs[k], Ps[k] = moments(state)
+        if step_outputs is not None:
+            for name, value in step_outputs(state).items():
                 extras.setdefault(name, []).append(value)
     return out.result(family.result_type, **{name: np.stack(values) for name, values in extras.items()})
 
