@@ -6,8 +6,8 @@ les démontrer), ``numbers`` (les nombres en français) et ``interactive`` (curs
 
 Importer le paquet ne charge que les filtres (numpy et scipy) : ``figures`` (matplotlib),
 ``scenarios``, ``interactive`` (bokeh, ipywidgets), ``numbers`` (Babel) et ``datasets`` se chargent à
-leur première utilisation (``kc.figures.draw(...)`` suffit). filterpy n'est jamais importé par le paquet
-hors de l'adaptateur de l'UKF de référence.
+leur première utilisation (``kc.figures.draw(...)`` suffit). filterpy n'est jamais importé par le paquet :
+c'est la référence des tests.
 """
 
 from .lecture import errata
@@ -47,8 +47,29 @@ from .core.results import FilterResult, FilterRuns
 from .core.simulation import Simulation, simulate
 from .diagnostics.monte_carlo import ConsistencyRuns, MonteCarlo, monte_carlo, monte_carlo_consistency
 from .tables import Table
-from .filters.filterpy_unscented import filterpy_unscented_filter
 from .core.validation import KalmanInputError
+# --- filtres à points : UKF, filtre particulaire, EnKF (issue 9) -------------------------------
+from .filters.unscented import (
+    SigmaPoints,
+    UnscentedTransform,
+    sigma_points,
+    sigma_weights,
+    unscented_kalman_filter,
+    unscented_transform,
+)
+from .filters.particle import (
+    RESAMPLING_SCHEMES,
+    ParticleFilterResult,
+    effective_sample_size,
+    multinomial_resample,
+    particle_filter,
+    resample,
+    residual_resample,
+    stratified_resample,
+    systematic_resample,
+)
+from .filters.ensemble import EnsembleFilterResult, ensemble_kalman_filter
+# --- fin des filtres à points ------------------------------------------------------------------
 # filtre d'information en racine carrée
 from .filters import square_root_information as srif
 from .filters.square_root_information import (
@@ -71,6 +92,19 @@ from . import se3_filter
 manifold = se3_filter  # ancien nom du module
 from .geometry.camera import PinholeCamera, camera_measurement, camera_measurement_jacobian
 from .geometry.lie import oplus, ominus, se3_adjoint, se3_exp, se3_log, se3_right_jacobian
+# lissage, vraisemblance, apprentissage de Q et R
+from . import likelihood
+from .filters.diffuse import DiffuseFilterResult, diffuse_kalman_filter
+from .filters.smoothers import SmootherResult, extended_rts_smoother, rts_smoother, unscented_rts_smoother
+from .likelihood import (
+    EMResult,
+    MaximumLikelihood,
+    expectation_maximization,
+    filter_log_likelihood,
+    log_likelihood,
+    log_likelihood_terms,
+    maximum_likelihood,
+)
 from .se3_filter import (
     SE3FilterResult,
     SE3Update,
@@ -134,7 +168,25 @@ __all__ = [
     "check_jacobian",
     "numerical_jacobian",
     "wrap_angle",
-    "filterpy_unscented_filter",
+    # --- filtres à points : UKF, filtre particulaire, EnKF (issue 9)
+    "SigmaPoints",
+    "UnscentedTransform",
+    "sigma_points",
+    "sigma_weights",
+    "unscented_transform",
+    "unscented_kalman_filter",
+    "RESAMPLING_SCHEMES",
+    "ParticleFilterResult",
+    "effective_sample_size",
+    "multinomial_resample",
+    "stratified_resample",
+    "systematic_resample",
+    "residual_resample",
+    "resample",
+    "particle_filter",
+    "EnsembleFilterResult",
+    "ensemble_kalman_filter",
+    # --- fin des filtres à points
     # filtre d'information en racine carrée
     "SquareRootInformation",
     "SrifUpdate",
@@ -176,12 +228,28 @@ __all__ = [
     "errata_se3",
     "lie",
     "manifold",
+    # lissage, vraisemblance, apprentissage de Q et R
+    "DiffuseFilterResult",
+    "diffuse_kalman_filter",
+    "SmootherResult",
+    "rts_smoother",
+    "extended_rts_smoother",
+    "unscented_rts_smoother",
+    "log_likelihood_terms",
+    "filter_log_likelihood",
+    "log_likelihood",
+    "MaximumLikelihood",
+    "maximum_likelihood",
+    "EMResult",
+    "expectation_maximization",
+    "likelihood",
+    "datasets",
     # sous-modules
     "errata",
     "figures",
+    "numbers",
     "scenarios",
     "interactive",
-    "numbers",
 ]
 
 __version__ = "0.1.0"

@@ -5,15 +5,15 @@ des curseurs, graduations des figures — passe par :func:`format_number` : virg
 insécable (U+202F) entre les milliers, signe moins typographique (U+2212) et puissances de dix écrites
 :math:`\times 10^{n}` (« 3,39 × 10⁻⁴ ») au lieu de la notation « e-04 ».
 
->>> format_number(0.000339, significant=3)
-'3,39 × 10⁻⁴'
->>> format_number(1234.5, decimals=1)
-'1\u202f234,5'
+Exemples : ``format_number(0.000339, significant=3)`` → « 3,39 × 10⁻⁴ » ;
+``format_number(1234.5, decimals=1)`` → « 1 234,5 » ; ``format_spec(0.25, ".1%")`` → « 25,0 % ».
+Les tests (``tests/test_numbers.py``) comparent ces écritures à des chaînes écrites à la main.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 from babel.numbers import format_decimal
@@ -26,7 +26,10 @@ __all__ = [
     "format_number",
     "format_integer",
     "format_percent",
+    "format_spec",
+    "format_array",
     "matplotlib_formatter",
+    "french_figure",
     "bokeh_tick_formatter",
     "glue_number",
 ]
@@ -58,8 +61,10 @@ def _check_digits(name: str, value: Any, minimum: int) -> int:
     return value
 
 
-def _fixed(x: float, decimals: int, group: bool = True) -> str:
-    pattern = ("#,##0" if group else "0") + ("." + "0" * decimals if decimals > 0 else "")
+def _fixed(x: float, decimals: int, group: bool = True, trim: bool = False) -> str:
+    # « # » : chiffre décimal facultatif (zéros finals retirés) ; « 0 » : chiffre toujours écrit
+    digit = "#" if trim else "0"
+    pattern = ("#,##0" if group else "0") + ("." + digit * decimals if decimals > 0 else "")
     text = format_decimal(round(x, decimals) + 0.0, format=pattern, locale=LOCALE)
     return text.replace("-", MINUS)
 
@@ -75,18 +80,19 @@ def format_number(
     significant: int | None = None,
     scientific: bool | None = None,
     unit: str | None = None,
+    trim: bool = False,
 ) -> str:
     r"""Un nombre écrit à la française.
 
     ``decimals`` : nombre fixe de décimales ; ``significant`` : nombre de chiffres significatifs (3 par
     défaut si aucun des deux n'est donné). ``scientific`` : écriture :math:`m \times 10^{n}` ; par défaut
     (``None``), choisie avec ``significant`` quand :math:`|x| < 10^{-3}` ou :math:`|x| \ge 10^{6}`.
-    ``unit`` : unité ajoutée après une espace insécable (« 0,08 m »). NaN s'écrit « NaN », l'infini « ∞ ».
+    ``unit`` : unité ajoutée après une espace insécable (« 0,08 m »). ``trim`` : retire les zéros
+    inutiles en fin de partie décimale (« 0,5 » plutôt que « 0,500 », comme le format ``g`` de Python).
+    NaN s'écrit « NaN », l'infini « ∞ ».
 
-    >>> format_number(-0.5, decimals=2)
-    '−0,50'
-    >>> format_number(2.5e-15, significant=2)
-    '2,5 × 10⁻¹⁵'
+    Exemples : ``format_number(-0.5, decimals=2)`` → « −0,50 » ;
+    ``format_number(2.5e-15, significant=2)`` → « 2,5 × 10⁻¹⁵ ».
     """
     x = _check_number(value)
     if decimals is not None and significant is not None:
@@ -100,7 +106,7 @@ def format_number(
     elif math.isinf(x):
         text = ("" if x > 0 else MINUS) + "∞"
     elif decimals is not None and not scientific:
-        text = _fixed(x, decimals)
+        text = _fixed(x, decimals, trim=trim)
     else:
         sig = 3 if significant is None else significant
         if decimals is not None:  # écriture scientifique demandée avec un nombre de décimales
@@ -113,9 +119,9 @@ def format_number(
         use_sci = scientific if scientific is not None else (x != 0 and (exponent < -3 or exponent >= 6))
         if use_sci:
             mantissa = rounded / 10.0**exponent
-            text = _power_of_ten(_fixed(mantissa, sig - 1, group=False), exponent)
+            text = _power_of_ten(_fixed(mantissa, sig - 1, group=False, trim=trim), exponent)
         else:
-            text = _fixed(rounded, max(sig - 1 - exponent, 0))
+            text = _fixed(rounded, max(sig - 1 - exponent, 0), trim=trim)
     return text if unit is None else f"{text}\u00a0{unit}"
 
 
@@ -133,23 +139,128 @@ def format_percent(value: Any, decimals: int = 0) -> str:
     return f"{_fixed(100.0 * x, _check_digits('decimals', decimals, 0))}{NNBSP}%"
 
 
-def matplotlib_formatter(**options: Any):
-    """Un ``matplotlib.ticker.FuncFormatter`` qui écrit les graduations avec :func:`format_number`
-    (``options`` : ceux de :func:`format_number` ; par défaut, autant de décimales que nécessaire)."""
-    from matplotlib.ticker import FuncFormatter
+_SPEC = re.compile(r"^(?P<sign>\+)?(?P<comma>,)?(?:\.(?P<precision>\d+))?(?P<kind>[fFeEgG%d])?$")
 
-    def fmt(value: float, _pos: int | None = None) -> str:
-        if options:
-            return format_number(value, **options)
-        if value == 0:
-            return "0"
-        text = f"{value:.6g}"
-        if "e" in text:
-            return format_number(value, significant=2)
-        decimals = len(text.split(".")[1]) if "." in text else 0
-        return format_number(value, decimals=decimals)
 
-    return FuncFormatter(fmt)
+def format_spec(value: Any, spec: str) -> str:
+    r"""Le nombre ``value`` écrit à la française d'après un format à la Python (``".3f"``, ``"{:.2e}"``…).
+
+    Traduction : ``.Nf`` → ``N`` décimales ; ``.Ne`` → ``N + 1`` chiffres significatifs en écriture
+    :math:`m \times 10^{n}` ; ``.Ng`` → ``N`` chiffres significatifs, zéros finals retirés (6 sans
+    précision) ; ``.N%`` → pourcentage à ``N`` décimales ; ``d`` → entier. Le séparateur « , » des
+    milliers est toujours mis (espace fine). Sert aux tableaux (:class:`~kalman_course.tables.Table`)
+    et à tout texte qui reçoit un format écrit pour Python.
+
+    Exemples : ``format_spec(0.000339, ".2e")`` → « 3,39 × 10⁻⁴ » ; ``format_spec(0.25, "{:.1%}")`` →
+    « 25,0 % » ; ``format_spec(0.5, ".3g")`` → « 0,5 ».
+    """
+    if not isinstance(spec, str):
+        raise KalmanInputError(f"« spec » doit être un format comme \".3f\" ; reçu {spec!r}.")
+    inner = spec[2:-1] if spec.startswith("{:") and spec.endswith("}") else spec.lstrip(":")
+    match = _SPEC.match(inner)
+    if match is None:
+        raise KalmanInputError(
+            f"Format « {spec} » non reconnu : attendu .Nf, .Ne, .Ng, .N% ou d (par exemple \".3f\")."
+        )
+    precision = None if match["precision"] is None else int(match["precision"])
+    kind = (match["kind"] or "g").lower()
+    if kind == "f":
+        text = format_number(value, decimals=6 if precision is None else precision)
+    elif kind == "e":
+        text = format_number(value, significant=7 if precision is None else precision + 1, scientific=True)
+    elif kind == "%":
+        return format_percent(value, 6 if precision is None else precision)
+    elif kind == "d":
+        text = format_integer(value)
+    else:
+        text = format_number(value, significant=6 if precision is None else max(precision, 1), trim=True)
+    if match["sign"] and not text.startswith(MINUS):
+        text = "+" + text
+    return text
+
+
+def format_array(values: Any, **options: Any) -> str:
+    """Un vecteur ou une matrice écrit à la française, une ligne par ligne de la matrice, colonnes
+    alignées à droite (``options`` : ceux de :func:`format_number`) ; pour les sorties ``print``.
+
+    Exemple : ``format_array([[1.5, -0.25], [10, 0]], decimals=2)`` donne les deux lignes
+    « [[ 1,50  −0,25] » et « [10,00   0,00]] ».
+    """
+    import numpy as np
+
+    arr = np.asarray(values, dtype=float)
+    if arr.ndim == 0:
+        return format_number(float(arr), **options)
+    if arr.ndim > 2:
+        raise KalmanInputError(f"« values » doit être un vecteur ou une matrice ; reçu {arr.ndim} dimensions.")
+    rows = np.atleast_2d(arr)
+    cells = [[format_number(v, **options) for v in row] for row in rows]
+    width = max(len(c) for row in cells for c in row)
+    lines = ["  ".join(c.rjust(width) for c in row) for row in cells]
+    if arr.ndim == 1:
+        return f"[{lines[0]}]"
+    return "[" + "\n ".join(f"[{line}]" for line in lines) + "]"
+
+
+def matplotlib_formatter():
+    r"""Formateur de graduations matplotlib (linéaires) en français : les graduations choisies par
+    ``ScalarFormatter`` (même nombre de décimales pour toutes), écrites par :func:`format_number`, et
+    le facteur commun éventuel écrit :math:`\times 10^{n}` ; aucun décalage additif (« +1e3 »).
+
+    Sur un axe gradué 0 ; 0,5 ; 1 : « 0,0 », « 0,5 », « 1,0 ».
+    """
+    from matplotlib.ticker import ScalarFormatter
+
+    class FrenchScalarFormatter(ScalarFormatter):
+        """``ScalarFormatter`` dont les graduations passent par :func:`format_number` (API publique
+        seulement : le texte anglais de matplotlib donne la valeur et le nombre de décimales)."""
+
+        def __init__(self) -> None:
+            super().__init__(useOffset=False, useMathText=False)
+
+        def __call__(self, x: float, pos: int | None = None) -> str:
+            english = super().__call__(x, pos)
+            if not english:
+                return english
+            plain = english.replace(MINUS, "-")
+            decimals = len(plain.split(".")[1]) if "." in plain else 0
+            return format_number(float(plain), decimals=decimals)
+
+        def get_offset(self) -> str:
+            english = super().get_offset().replace(MINUS, "-")
+            found = re.fullmatch(r"1e([-+]?\d+)", english.strip())
+            if found is None:
+                return english
+            return f"×{NNBSP}10{str(int(found[1])).translate(_SUPERSCRIPT)}"
+
+        def format_data_short(self, value: float) -> str:
+            return format_number(value, significant=4)
+
+    return FrenchScalarFormatter()
+
+
+def french_figure(figure) -> None:
+    """Une figure matplotlib à la française : graduations des axes linéaires par
+    :func:`matplotlib_formatter` (les formateurs choisis par la figure elle-même, logarithmiques ou
+    autres, sont laissés) et typographie des textes — titres, légendes, libellés, annotations — par
+    :func:`kalman_course.book_typography.french_spacing` (espaces insécables, apostrophe « ’ »,
+    formules ``$…$`` intactes)."""
+    from matplotlib.text import Text
+    from matplotlib.ticker import ScalarFormatter
+
+    from .book_typography import french_spacing
+
+    for ax in figure.get_axes():
+        for axis in (ax.xaxis, ax.yaxis, getattr(ax, "zaxis", None)):
+            if axis is None:
+                continue
+            if type(axis.get_major_formatter()) is ScalarFormatter:
+                axis.set_major_formatter(matplotlib_formatter())
+    for text in figure.findobj(Text):
+        old = text.get_text()
+        new = french_spacing(old)
+        if new != old:
+            text.set_text(new)
 
 
 def bokeh_tick_formatter():
@@ -161,22 +272,34 @@ def bokeh_tick_formatter():
     if (!isFinite(tick)) { return String(tick); }
     if (tick === 0) { return "0"; }
     const sup = {"-": "⁻", "0": "⁰", "1": "¹", "2": "²", "3": "³", "4": "⁴", "5": "⁵", "6": "⁶", "7": "⁷", "8": "⁸", "9": "⁹"};
-    let text = Number(tick.toPrecision(6)).toString();
-    if (text.includes("e")) {
-        const [m, e] = Number(tick).toExponential(1).split("e");
+    const french = (s) => {
+        const neg = s.startsWith("-");
+        const [int, dec] = (neg ? s.slice(1) : s).split(".");
+        const grouped = int.replace(/\B(?=(\d{3})+(?!\d))/g, "\u202f");
+        return (neg ? "\u2212" : "") + grouped + (dec ? "," + dec : "");
+    };
+    const a = Math.abs(tick);
+    if (a < 1e-3 || a >= 1e6) {
+        const [m, e] = tick.toExponential(2).split("e");
+        const mantissa = String(parseFloat(m));
         const exp = String(parseInt(e, 10)).split("").map(c => sup[c]).join("");
-        text = m + "\u202f×\u202f10" + exp;
+        return french(mantissa) + "\u202f×\u202f10" + exp;
     }
-    return text.replace(".", ",").replace(/^-/, "\u2212");
+    return french(String(Number(tick.toPrecision(6))));
     """
     return CustomJSTickFormatter(code=code)
 
 
-def glue_number(name: str, value: Any, **options: Any) -> str:
-    """Colle (myst-nb ``glue``, sans affichage) le nombre ``value`` écrit par :func:`format_number` sous le
-    nom ``name``, pour ``{glue:text}`name``` dans la prose ; renvoie le texte collé."""
+def glue_number(name: str, value: Any, spec: str | None = None, **options: Any) -> str:
+    """Colle (myst-nb ``glue``, sans affichage) le nombre ``value`` écrit à la française sous le nom
+    ``name``, pour ``{glue:text}`name``` (sans format) dans la prose ; renvoie le texte collé.
+
+    ``options`` : ceux de :func:`format_number` (``decimals=3``, ``significant=2``…) ; ou bien ``spec`` :
+    un format à la Python traduit par :func:`format_spec` (``spec=".1%"`` pour un pourcentage)."""
     from myst_nb import glue
 
-    text = format_number(value, **options)
+    if spec is not None and options:
+        raise KalmanInputError("Donnez « spec » ou les options de format_number, pas les deux.")
+    text = format_spec(value, spec) if spec is not None else format_number(value, **options)
     glue(name, text, display=False)
     return text

@@ -12,6 +12,9 @@ from .core.validation import KalmanInputError
 
 __all__ = ["Table"]
 
+#: Un champ de format ``{:spec}`` dans le format d'une colonne.
+_FIELD = re.compile(r"\{:([^{}]*)\}")
+
 
 def _html_cell(text: str) -> str:
     """Échappe le HTML hors des formules ; ``$…$`` devient ``\\(…\\)``."""
@@ -26,9 +29,12 @@ class Table:
     r"""Tableau de colonnes numériques (ou textuelles), formaté colonne par colonne.
 
     ``headers`` : en-têtes (Markdown, formules :math:`\LaTeX` permises) ; ``columns`` : une séquence de
-    valeurs par colonne, toutes de même longueur ; ``formats`` : un format ``str.format`` par colonne
-    (``"{:.4g}"``…), ``None`` pour ``str``. S'affiche en HTML dans un carnet et dans le livre
-    (``_repr_html_``, formules pour MathJax) ; ``str(table)`` donne le Markdown.
+    valeurs par colonne, toutes de même longueur ; ``formats`` : un format à la Python par colonne
+    (``"{:.4g}"``, ``"{:.2e}"``…, éventuellement entouré de texte : ``"{:.1f} cm"``), ``None`` pour le
+    format par défaut. Les nombres sont toujours écrits en français par
+    :func:`kalman_course.numbers.format_spec` (virgule décimale, :math:`\times 10^{n}`) ; un texte est
+    recopié tel quel. S'affiche en HTML dans un carnet et dans le livre (``_repr_html_``, formules pour
+    MathJax) ; ``str(table)`` donne le Markdown.
     """
 
     def __init__(
@@ -47,6 +53,12 @@ class Table:
         formats = [None] * len(headers) if formats is None else list(formats)
         if len(formats) != len(headers):
             raise KalmanInputError("« formats » doit donner un format par colonne.")
+        for fmt in formats:
+            if fmt is not None and (not isinstance(fmt, str) or len(_FIELD.findall(fmt)) != 1):
+                raise KalmanInputError(
+                    f"Chaque format de colonne doit contenir un champ « {{:…}} » (par exemple \"{{:.3f}}\") ; "
+                    f"reçu {fmt!r}."
+                )
         self.headers = list(headers)
         self.columns = [list(np.asarray(c).tolist()) if isinstance(c, np.ndarray) else list(c) for c in columns]
         self.formats = formats
@@ -58,9 +70,17 @@ class Table:
 
     def cell(self, row: int, col: int) -> str:
         """Texte de la case (ligne ``row``, colonne ``col``)."""
+        from .numbers import format_integer, format_spec  # Babel, chargé à l'affichage seulement
+
         value = self.columns[col][row]
         fmt = self.formats[col]
-        return str(value) if fmt is None else fmt.format(value)
+        if isinstance(value, str) or value is None:
+            return "" if value is None else value
+        if fmt is None:
+            if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+                return format_integer(value)
+            return format_spec(value, "g")
+        return _FIELD.sub(lambda m: format_spec(value, m[1]), fmt)
 
     def to_markdown(self) -> str:
         """Le tableau en Markdown (tableau à barres verticales)."""

@@ -1,16 +1,35 @@
 #!/usr/bin/env bash
 # Construit le site dans _build/html (installe d'abord ce qu'il faut : voir scripts/setup.sh).
+# Avec --pdf : construit aussi le cours en un seul PDF, _build/pdf/filtre-de-kalman.pdf (LaTeX de
+# Jupyter Book, XeLaTeX, césure française) ; setup.sh installe alors TeX Live (paquets Debian).
 # Toutes les pages sont réécrites (--all) ; les carnets inchangés viennent du cache d'exécution.
 # La construction échoue sur toute erreur de cellule et tout avertissement Sphinx (-W).
+# Les autres arguments sont transmis à « jupyter-book build ».
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+
+pdf=0
+args=()
+for arg in "$@"; do
+  if [ "$arg" = "--pdf" ]; then pdf=1; else args+=("$arg"); fi
+done
+if [ "$pdf" = 1 ]; then bash scripts/setup.sh --pdf; else bash scripts/setup.sh; fi
+
 # Le cache d'exécution ne connaît que le code des cellules : si le paquet a changé, on l'efface,
 # sinon les pages montreraient des résultats calculés par l'ancienne version.
-pkg_sha=$(find kalman_course -name '*.py' -print0 | sort -z | xargs -0 cat | sha256sum | cut -d' ' -f1)
+pkg_sha=$(.venv/bin/python scripts/package_hash.py)
 if [ "$(cat _build/.kalman_course.sha 2>/dev/null)" != "$pkg_sha" ]; then
   rm -rf _build/.jupyter_cache
   mkdir -p _build && echo "$pkg_sha" > _build/.kalman_course.sha
 fi
-.venv/bin/jupyter-book build . --all -W --keep-going "$@"
+.venv/bin/jupyter-book build . --all -W --keep-going ${args[@]+"${args[@]}"}
 echo "Site construit : $(pwd)/_build/html/index.html"
+
+if [ "$pdf" = 1 ]; then
+  start=$(date +%s)
+  # Même cache d'exécution et même environnement Sphinx que le site, qu'on vient de reconstruire en
+  # entier : aucun carnet n'est relancé, aucune page relue.
+  .venv/bin/jupyter-book build . --builder latex -W --keep-going ${args[@]+"${args[@]}"}
+  .venv/bin/python scripts/pdf.py _build/latex _build/pdf/filtre-de-kalman.pdf
+  echo "PDF construit en $(( $(date +%s) - start )) s : $(pwd)/_build/pdf/filtre-de-kalman.pdf"
+fi

@@ -1,53 +1,141 @@
 #!/usr/bin/env bash
 # Prépare tout ce dont la construction et les tests ont besoin, sans rien supposer de la machine :
-#   - .venv/ : Python 3.11 avec requirements.txt (versions figées) et le paquet kalman_course (éditable) ;
+#   - .venv/ : Python 3.11 ou 3.12 avec requirements.txt (versions figées) et le paquet kalman_course (éditable) ;
 #   - node_modules/ : MathJax et mermaid-cli (package-lock.json), sans téléchargement de navigateur ;
 #   - book/vendor/ : les ressources web copiées pour être servies par le site lui-même (hors ligne) ;
-#   - Chromium (paquet Debian) : rendu des diagrammes Mermaid à la construction et tests navigateur.
+#   - Chromium (paquet Debian) : rendu des diagrammes Mermaid à la construction et tests navigateur ;
+#   - avec --pdf seulement : TeX Live (XeLaTeX, français, latexmk), polices et pdftotext (paquets Debian),
+#     pour le livre en PDF.
+# Interpréteur : la variable PYTHON s'il est donné (ex. PYTHON=/usr/bin/python3), sinon le premier
+# Python pris en charge parmi python3, python3.12, python3.11, /usr/bin/python3.
 # Idempotent : une seconde exécution ne refait que ce qui a changé.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 log() { printf '[setup] %s\n' "$*" >&2; }
 
-# --- Chromium (Debian) --------------------------------------------------------------------------
-if [ ! -x /usr/bin/chromium ]; then
+want_pdf=0
+for arg in "$@"; do
+  case "$arg" in
+    --pdf) want_pdf=1 ;;
+    *) log "ERREUR : option inconnue « $arg » (seule option : --pdf)"; exit 2 ;;
+  esac
+done
+
+# Pythons pris en charge : ceux sur lesquels requirements.txt s'installe et les tests passent.
+SUPPORTED_TEXT="3.11 (dès 3.11.2, celui de Debian 12) et 3.12 (celui d'Ubuntu 24.04)"
+python_version() { "$1" -c 'import sys; print("%d.%d.%d" % sys.version_info[:3])' 2>/dev/null; }
+is_supported() { case "$1" in 3.11.0|3.11.1) return 1 ;; 3.11.*|3.12.*) return 0 ;; *) return 1 ;; esac; }
+
+apt_install() {
+  # apt_install RAISON PAQUET… : installe des paquets Debian si l'on est root, sinon explique quoi faire.
+  local why=$1; shift
   if [ "$(id -u)" = "0" ] && command -v apt-get >/dev/null; then
-    log "installation de Chromium (apt-get install chromium)…"
+    log "installation de $why (apt-get install $*)…"
     apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@" >/dev/null
   else
-    log "ERREUR : Chromium est introuvable (/usr/bin/chromium). Installez le paquet Debian « chromium »"
-    log "         (sudo apt-get install chromium) puis relancez."
+    log "ERREUR : $why manque. Installez les paquets Debian suivants puis relancez :"
+    log "         sudo apt-get install --no-install-recommends $*"
     exit 1
   fi
+}
+
+# --- Chromium (Debian) --------------------------------------------------------------------------
+if [ ! -x /usr/bin/chromium ]; then
+  apt_install "Chromium" chromium
+fi
+
+# --- TeX Live, seulement pour le PDF (--pdf) ------------------------------------------------------
+# XeLaTeX + polyglossia (césure française), latexmk, les classes et extensions LaTeX de Sphinx, les
+# polices FreeFont (celles de Sphinx avec XeLaTeX) et DejaVu, pdftotext (poppler-utils) pour les tests.
+TEX_PACKAGES=(texlive-xetex texlive-lang-french texlive-latex-recommended texlive-latex-extra
+  texlive-fonts-recommended texlive-plain-generic latexmk fonts-freefont-otf fonts-dejavu-core
+  fonts-dejavu-extra poppler-utils)
+tex_ready() {
+  command -v xelatex >/dev/null && command -v latexmk >/dev/null && command -v pdftotext >/dev/null \
+    && kpsewhich polyglossia.sty >/dev/null && kpsewhich hyph-fr.tex >/dev/null \
+    && kpsewhich fncychap.sty >/dev/null && fc-list | grep -q FreeSerif
+}
+if [ "$want_pdf" = 1 ] && ! tex_ready; then
+  apt_install "TeX Live pour le PDF (XeLaTeX, français)" "${TEX_PACKAGES[@]}"
+  tex_ready || { log "ERREUR : TeX Live installé mais incomplet (xelatex, latexmk, polyglossia, césure fr)"; exit 1; }
 fi
 
 # --- Python -------------------------------------------------------------------------------------
-PYTHON_BIN=${PYTHON:-python3}
-if [ ! -x .venv/bin/python ]; then
-  log "création de l'environnement virtuel .venv"
-  "$PYTHON_BIN" -m venv .venv
+# PYTHON donné : ce Python (un .venv fait avec un autre est refait). Sinon : le .venv existant s'il est
+# d'un Python pris en charge, ou le premier Python pris en charge trouvé.
+base_of() { "$1" -c 'import os, sys; print(os.path.realpath(sys._base_executable))' 2>/dev/null || echo "?"; }
+venv_v=""
+[ -x .venv/bin/python ] && venv_v=$(python_version .venv/bin/python || echo "?")
+if [ -n "${PYTHON:-}" ]; then
+  PYTHON_BIN=$PYTHON
+  v=$(python_version "$PYTHON_BIN") || { log "ERREUR : PYTHON=$PYTHON n'est pas un interpréteur Python utilisable."; exit 1; }
+  if ! is_supported "$v"; then
+    log "ERREUR : PYTHON=$PYTHON est Python $v. Pythons pris en charge : $SUPPORTED_TEXT."
+    exit 1
+  fi
+  if [ -n "$venv_v" ] && [ "$(base_of .venv/bin/python)" != "$(base_of "$PYTHON_BIN")" ]; then
+    log ".venv utilise Python $venv_v ($(base_of .venv/bin/python)) ; on le refait avec PYTHON=$PYTHON ($v)"
+    rm -rf .venv
+  fi
+elif [ -n "$venv_v" ] && is_supported "$venv_v"; then
+  PYTHON_BIN=$(base_of .venv/bin/python)
+else
+  PYTHON_BIN=""
+  seen=""
+  for candidate in python3 python3.12 python3.11 /usr/bin/python3; do
+    command -v "$candidate" >/dev/null || continue
+    v=$(python_version "$candidate") || continue
+    if is_supported "$v"; then PYTHON_BIN=$(command -v "$candidate"); break; fi
+    seen="$seen $candidate ($v)"
+  done
+  if [ -z "$PYTHON_BIN" ]; then
+    log "ERREUR : aucun Python pris en charge trouvé${seen:+ (trouvé :$seen)}."
+    log "         Pythons pris en charge : $SUPPORTED_TEXT."
+    log "         Installez-en un, ou indiquez-le : PYTHON=/chemin/vers/python3.12 bash scripts/setup.sh"
+    exit 1
+  fi
+  [ -n "$seen" ] && log "non pris en charge :$seen ; Pythons pris en charge : $SUPPORTED_TEXT."
+  if [ -n "$venv_v" ]; then
+    log ".venv utilise Python $venv_v, non pris en charge ; on le refait"
+    rm -rf .venv
+  fi
 fi
+if [ ! -x .venv/bin/python ]; then
+  v=$(python_version "$PYTHON_BIN")
+  log "création de l'environnement virtuel .venv (Python $v, $PYTHON_BIN)"
+  if ! "$PYTHON_BIN" -m venv .venv; then
+    rm -rf .venv
+    log "ERREUR : « $PYTHON_BIN -m venv » a échoué. Sur Debian/Ubuntu : sudo apt-get install python3-venv"
+    exit 1
+  fi
+fi
+v=$(python_version .venv/bin/python)
 stamp=.venv/.requirements.sha
-want=$(cat requirements.txt pyproject.toml | sha256sum | cut -d' ' -f1)
+want=$( (cat requirements.txt pyproject.toml; echo "$v") | sha256sum | cut -d' ' -f1)
 pip_quiet() {
   # pip dans un journal ; en cas d'échec, on montre la fin du journal et on s'arrête.
   local logfile=.venv/pip-install.log
   if ! .venv/bin/python -m pip install -q --disable-pip-version-check "$@" >"$logfile" 2>&1; then
-    log "ERREUR : pip install $* a échoué ; fin du journal ($logfile) :"
+    log "ERREUR : pip install $* a échoué (Python $v) ; fin du journal ($logfile) :"
     grep -v "^WARNING: Location" "$logfile" | tail -n 30 >&2
+    log "Pythons pris en charge : $SUPPORTED_TEXT."
     exit 1
   fi
 }
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
-  log "installation des dépendances Python (requirements.txt)…"
+  log "installation des dépendances Python (requirements.txt, Python $v)…"
   pip_quiet -r requirements.txt
   pip_quiet --no-deps -e .
   .venv/bin/python -c "import kalman_course, kalman_course.interactive, filterpy, myst_nb" \
     || { log "ERREUR : installation Python incomplète"; exit 1; }
   echo "$want" > "$stamp"
 fi
+# Configuration des noyaux de .venv (retire l'avis « TCP without encryption » : voir ce fichier).
+mkdir -p .venv/etc/ipython
+cmp -s scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.py \
+  || cp scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.py
 
 # --- npm ----------------------------------------------------------------------------------------
 stamp_npm=node_modules/.lock.sha

@@ -15,6 +15,9 @@ import pytest
 import yaml
 
 import kalman_course as kc
+from kalman_course.figures._registry import CHAPTER_TITLES
+
+from conftest import ROOT as REPO_ROOT, tree_state
 
 ROOT = Path(__file__).resolve().parent.parent
 BOOK = ROOT / "book"
@@ -24,15 +27,17 @@ LINEAR_CHAPTERS = [
     "controle-systeme", "estimateur", "predicteur-correcteur", "gain-optimal", "tension-constante",
     "pratique-synthese",
 ]
-# Tous les chapitres du livre (hors introduction et références), tels que _toc.yml les liste.
+# Annexes : pages sans figure ni exercice.
+APPENDICES = {"references", "errata"}
+# Tous les chapitres du livre (hors introduction et annexes), tels que _toc.yml les liste.
 ALL_CHAPTERS = [
     Path(f).name
     for f in [c["file"] for part in yaml.safe_load((ROOT / "_toc.yml").read_text())["parts"] for c in part["chapters"]]
-    if Path(f).name != "references"
+    if Path(f).name not in APPENDICES
 ]
-# Seul bruit toléré dans le journal : l'avertissement d'ipykernel sur le transport TCP local des noyaux
-# (TOOLCHAIN.md : « Console noise that is not an error »).
-TOLERATED = re.compile(r"\[IPKernelApp\] WARNING \| Kernel is running over TCP without encryption")
+# Aucun avertissement n'est toléré dans le journal. (L'avis d'ipykernel « Kernel is running over TCP
+# without encryption », émis par chaque noyau qui parle en TCP local à la construction, est retiré à la
+# source par scripts/ipython_kernel_config.py, que scripts/setup.sh installe dans .venv.)
 
 
 def _toc_files() -> list[str]:
@@ -83,15 +88,32 @@ def test_each_chapter_has_an_exercise_with_a_hidden_computed_solution(chapter):
         assert "kc." in "".join(_code_cells(block.group(1) + "```")), f"{label} : la solution n'appelle pas le paquet"
 
 
+def test_figure_registry_knows_every_chapter_title():
+    """``python -m kalman_course.figures --list`` cite le chapitre de chaque figure par son titre : ces
+    titres (kalman_course/figures/_registry.py) doivent être ceux des chapitres du livre."""
+    for chapter in sorted({spec.chapter for spec in kc.figures.REGISTRY.values()}):
+        heading = re.search(r"(?m)^# (.+)$", (BOOK / f"{chapter}.md").read_text()).group(1).strip()
+        assert CHAPTER_TITLES.get(chapter) == heading, (
+            f"{chapter} : titre « {heading} » absent de CHAPTER_TITLES ou différent"
+        )
+
+
 # --------------------------------------------------------------------------- construction
 
 
 @pytest.mark.book
 def test_build_log_has_no_warning(built_book):
     log = (built_book.parent / "build.log").read_text()
-    warnings = [line for line in log.splitlines() if "WARNING" in line and not TOLERATED.search(line)]
+    warnings = [line for line in log.splitlines() if "WARNING" in line]
     assert not warnings, "\n".join(warnings)
     assert "build succeeded" in log
+
+
+@pytest.mark.book
+def test_build_leaves_the_user_build_untouched(built_book, user_build_before):
+    """Les tests construisent ailleurs (dossier temporaire) : _build/ du dépôt est intact."""
+    assert not built_book.is_relative_to(REPO_ROOT / "_build")
+    assert tree_state(REPO_ROOT / "_build") == user_build_before
 
 
 @pytest.mark.book
@@ -160,3 +182,97 @@ def test_references_page_has_the_thirty_lecture_references(built_book):
     # les chapitres citent la page des références
     intro = (built_book / "book" / "intro.html").read_text()
     assert "references.html#" in intro
+
+
+# --------------------------------------------------------------------------- annexe des errata
+
+
+def _errata_labels() -> set[str]:
+    return set(re.findall(r"^\((errata-[\w-]+)\)=$", (BOOK / "errata.md").read_text(), re.M))
+
+
+def test_errata_appendix_names_existing_tests():
+    text = (BOOK / "errata.md").read_text()
+    cited = set(re.findall(r"`(test_\w+)`", text))
+    defined = set()
+    for path in (ROOT / "tests").glob("test_*.py"):
+        defined |= set(re.findall(r"^def (test_\w+)\(", path.read_text(), re.M))
+    assert cited, "l'annexe ne cite aucun test"
+    assert not cited - defined, f"tests cités mais absents : {sorted(cited - defined)}"
+
+
+def test_errata_appendix_has_the_corrections_the_chapters_did_not_cover():
+    labels = _errata_labels()
+    for number in ("000-1", "000-3", "000-11", "002-1", "002-2", "002-6", "004-5", "004-6"):
+        assert f"errata-{number}" in labels, number
+    # chaque entrée : écrit, correct, pourquoi, vérifié par
+    entries = re.split(r"^\(errata-[\w-]+\)=$", (BOOK / "errata.md").read_text(), flags=re.M)[1:]
+    assert len(entries) == len(labels)
+    for entry in entries:
+        for field in ("Écrit\n:", "Correct\n:", "Pourquoi\n:", "Vérifié par\n:"):
+            assert field in entry, entry[:80]
+
+
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
+def test_erratum_boxes_are_short_and_link_to_the_appendix(chapter):
+    text = (BOOK / f"{chapter}.md").read_text()
+    labels = _errata_labels()
+    for box in re.findall(r":::\{admonition\} Erratum[^\n]*\n:class: warning\n(.*?)\n:::", text, re.S):
+        links = re.findall(r"\{ref\}`(errata-[\w-]+)`", box)
+        assert links, f"{chapter} : encadré Erratum sans lien vers l'annexe : {box[:80]}"
+        assert set(links) <= labels, f"{chapter} : lien(s) inconnu(s) {set(links) - labels}"
+        assert len(box) < 900, f"{chapter} : encadré trop long ({len(box)} caractères) : {box[:80]}"
+    # aucun renvoi à des documents ou numéros de ligne que l'étudiant n'a pas
+    prose = re.sub(r"```\{code-cell\}.*?```", "", text, flags=re.S)
+    assert not re.search(r"\bl\.\s*\d|ALGORITHMS|\.txt\b", prose), chapter
+
+
+# --------------------------------------------------------------------------- cellules et figures
+
+
+def _cells_with_metadata(text: str) -> list[tuple[dict, str]]:
+    """Les cellules de code : (métadonnées, source)."""
+    cells = []
+    for body in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, flags=re.S):
+        meta: dict = {}
+        if body.startswith("---\n"):
+            head, body = body[4:].split("\n---\n", 1)
+            meta = yaml.safe_load(head) or {}
+        else:
+            options = re.match(r"((?::[\w-]+:.*\n)*)", body)[1]
+            for key, value in re.findall(r"^:([\w-]+):\s*(.*)$", options, re.M):
+                meta[key] = yaml.safe_load(value)
+            body = body[len(options):]
+        cells.append((meta, body))
+    return cells
+
+
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
+def test_every_figure_has_a_caption_a_name_and_an_alt_text(chapter):
+    for meta, body in _cells_with_metadata((BOOK / f"{chapter}.md").read_text()):
+        drawn = re.findall(r'kc\.figures\.draw\("([^"]+)"\)', body)
+        if not drawn:
+            continue
+        figure = meta.get("mystnb", {}).get("figure", {})
+        alt = meta.get("mystnb", {}).get("image", {}).get("alt", "")
+        assert len(figure.get("caption", "")) > 20, f"{chapter} : {drawn[0]} sans légende"
+        assert figure.get("name") == f"fig-{drawn[0]}", f"{chapter} : {drawn[0]} sans nom de figure"
+        assert len(alt) > 40, f"{chapter} : {drawn[0]} sans texte de remplacement"
+
+
+@pytest.mark.parametrize("chapter", ALL_CHAPTERS)
+def test_bookkeeping_cells_are_hidden(chapter):
+    """Une cellule qui colle des nombres, ou qui ne fait qu'importer, est cachée aux étudiants."""
+    for meta, body in _cells_with_metadata((BOOK / f"{chapter}.md").read_text()):
+        tags = set(meta.get("tags", []))
+        code = [line for line in body.splitlines() if line.strip() and not line.lstrip().startswith("#")]
+        glues = re.search(r"\bglue(_number)?\(", body)
+        imports_only = code and all(re.match(r"(import|from)\s", line) for line in code)
+        if glues or imports_only:
+            assert tags & {"remove-cell", "remove-input"}, f"{chapter} : cellule visible :\n{body[:200]}"
+
+
+def test_errata_headings_have_no_math():
+    """Un titre d'entrée sert de texte aux liens {ref} des chapitres, rendu sans MathJax : pas de $…$."""
+    headings = re.findall(r"^### (.*)$", (BOOK / "errata.md").read_text(), re.M)
+    assert headings and not [h for h in headings if "$" in h or "\\" in h]

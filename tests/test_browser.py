@@ -5,6 +5,11 @@ fait échouer le test. Pour chaque page : aucune erreur de page, formules typogr
 (servi par le site), diagrammes mermaid dessinés. Sur les pages à curseurs statiques : les curseurs
 sont déplacés par de vrais événements clavier et souris, et les données tracées, relues dans le
 document Bokeh, sont comparées aux exécutions calculées ici par le paquet.
+
+Le français de chaque page est vérifié dans le texte courant (hors code, formules, adresses) : aucun
+TeX brut, aucun nombre à l'anglaise (« 0.5 », « 1e-05 »), une espace insécable devant « : ; ? ! » et
+dans « », aucune erreur MathJax, aucun caractère de contrôle, aucune cellule de collage (``glue``)
+visible, et chaque image a une légende et un texte de remplacement.
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ import playwright.sync_api as playwright_api
 import pytest
 
 import kalman_course.interactive as ki
+from kalman_course.book_typography import french_spacing
 from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
 
 pytestmark = pytest.mark.browser
@@ -35,6 +41,9 @@ CHROMIUM_ARGS = [
 # Aucune erreur de page n'est tolérée. (sphinx-thebe, chargée d'office par Jupyter Book 1, insère deux
 # fois son script « const THEBE_JS_URL = … » ; l'extension du livre retire la copie, et
 # page_errors vérifie qu'il n'en reste qu'une.)
+
+#: Annexes du livre (ni figure à curseurs, ni quiz).
+APPENDICES = {"references", "errata"}
 
 #: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet, depuis son registre).
 EXPECTED_GRIDS = {name: (lambda name=name: ki.slider_grid(name)) for name in ki.slider_names()}
@@ -133,17 +142,45 @@ def page_errors(visit: Visit, html: str) -> list[str]:
     return errors
 
 
-_RAW_TEX = r"""() => {
-  const skip = 'pre, code, script, style, mjx-container, noscript, textarea, .highlight';
-  const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
-  const found = [];
+# Le texte courant de l'article (hors code, formules, SVG, figures Bokeh, liens qui affichent une adresse) :
+# TeX brut, nombres à l'anglaise, espaces ordinaires devant « : ; ? ! » ou dans « ».
+_PROSE = r"""() => {
+  const root = document.querySelector('main') || document.body;
+  const skip = 'pre, code, kbd, samp, script, style, mjx-container, noscript, textarea, svg, object, ' +
+               '.highlight, .math, .kc-bokeh-figure, .headerlink';
+  const walker = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  const out = {tex: [], english: [], space: [], guillemets: []};
+  const around = (t, i) => t.slice(Math.max(0, i - 25), i + 25).replace(/\s+/g, ' ');
+  const scan = (re, t, list) => { let m; re.lastIndex = 0; while ((m = re.exec(t))) list.push(around(t, m.index)); };
   for (let n = walker.nextNode(); n; n = walker.nextNode()) {
-    if (n.parentElement && n.parentElement.closest(skip)) continue;
+    const el = n.parentElement;
+    if (!el || el.closest(skip)) continue;
     const t = n.textContent;
-    if (/\$\$|\\\(|\\\)|\\\[|\\\]|\\frac|\\begin\{/.test(t)) found.push(t.trim().slice(0, 80));
+    if (el.closest('a') && /^\s*(https?:|www\.|doi:)/i.test(t)) continue;  // une adresse affichée
+    scan(/\$\$|\\\(|\\\)|\\\[|\\\]|\\[a-zA-Z]{2,}|\{glue|\{eq\}|\{doc\}/g, t, out.tex);
+    // 0.5, -3.25, 1.2e-05, 3e+02 ; pas 2.0.0 (version), 10.1115/… (DOI), 1:30, a.b
+    scan(/(?<![\w.,\/:\u2212-])(?<!§[\s\u00a0\u202f]?)[-\u2212]?\d+\.\d+(?![\w\/]|\.\d)|(?<![\w.])\d+(?:\.\d+)?e[-+]?\d+(?!\w)/g, t, out.english);
+    scan(/[ \t\n\r](?=[:;!?](?![\w\/]))/g, t, out.space);
+    scan(/«(?![\u00a0\u202f])|(?<![\u00a0\u202f])»/g, t, out.guillemets);
   }
-  return found;
+  return out;
 }"""
+
+# Cellules de code visibles qui collent des nombres (elles doivent être cachées).
+_GLUE_CELLS = r"""() => [...document.querySelectorAll('main .cell_input')]
+    .filter(c => /\bglue(_number)?\(/.test(c.textContent)).map(c => c.textContent.trim().slice(0, 60))"""
+
+# Images sans légende numérotée ou sans texte de remplacement (un nom de fichier ne compte pas).
+_IMAGES = r"""() => [...document.querySelectorAll('main img')].filter(img => {
+  const alt = (img.getAttribute('alt') || '').trim();
+  const altOk = alt.length > 0 && !/\.(png|jpe?g|svg|gif|webp)$/i.test(alt);
+  const figure = img.closest('figure');
+  const caption = figure && figure.querySelector('figcaption');
+  return !(altOk && caption && caption.textContent.trim().length > 0);
+}).map(img => img.getAttribute('src'))"""
+
+#: Caractères de contrôle (hors tabulation et fins de ligne) : un « \a » de « \approx » devenu BEL…
+_CONTROL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
 
 _MATH = """() => [...document.querySelectorAll('.math')].map(el => !!el.querySelector('mjx-container'))"""
 
@@ -194,9 +231,23 @@ def test_every_page_is_offline_typeset_and_drawn(site, browser):
         if '<span class="math' in html or '<div class="math' in html:
             if page.locator("mjx-container").count() == 0:
                 problems.append(f"{name} : aucune sortie MathJax")
-        raw = page.evaluate(_RAW_TEX)
-        if raw:
-            problems.append(f"{name} : TeX brut visible {raw[:3]}")
+        prose = page.evaluate(_PROSE)
+        for kind, label in (("tex", "TeX brut visible"), ("english", "nombre à l'anglaise dans le texte"),
+                            ("space", "espace ordinaire devant « : ; ? ! »"),
+                            ("guillemets", "guillemets sans espace insécable")):
+            if prose[kind]:
+                problems.append(f"{name} : {len(prose[kind])} × {label}, par exemple {prose[kind][:3]}")
+        if page.locator("mjx-merror, [data-mjx-error]").count():
+            problems.append(f"{name} : erreur MathJax ({page.locator('mjx-merror').first.text_content()!r})")
+        control = _CONTROL.findall(html)
+        if control:
+            problems.append(f"{name} : caractère(s) de contrôle dans la page {sorted(set(control))}")
+        glue_cells = page.evaluate(_GLUE_CELLS)
+        if glue_cells:
+            problems.append(f"{name} : cellule(s) de collage visible(s) {glue_cells[:2]}")
+        images = page.evaluate(_IMAGES)
+        if images:
+            problems.append(f"{name} : {len(images)} image(s) sans légende ou sans texte de remplacement")
         if page.locator(".mermaid, object[data*='mermaid'], img[src*='mermaid']").count():
             try:  # attendre le chargement des SVG ; un échec est signalé plus bas, diagramme par diagramme
                 page.wait_for_function(
@@ -251,10 +302,10 @@ def _check_plotted(page, k: int, grid, root, name: str | None = None) -> tuple[i
     np.testing.assert_array_equal(state["data"]["t"], grid.time)
     # les curseurs affichent les vraies valeurs du point de grille
     shown = [root.locator(".bk-slider-value").nth(s).text_content() for s in range(len(grid.axes))]
-    assert shown == [axis.labels()[i] for axis, i in zip(grid.axes, index)]
+    assert shown == [french_spacing(axis.labels()[i]) for axis, i in zip(grid.axes, index)]
     # le texte de lecture donne les nombres de cette exécution, calculés par le paquet
     if name is not None and ki.slider_spec(name).readout is not None:
-        assert state["readout"] == ki.slider_spec(name).text_at(*index)
+        assert state["readout"] == french_spacing(ki.slider_spec(name).text_at(*index))
     return index
 
 
@@ -371,6 +422,31 @@ def test_interactive_chapter_works_from_file_url(site, browser):
     page.context.close()
 
 
+def test_prose_checks_flag_prose_only(browser):
+    """Les vérifications du français (sur une page écrite ici) signalent le texte courant fautif et
+    laissent le code, les formules, les adresses, les heures et les numéros de version."""
+    NB, NN = "\u00a0", "\u202f"
+    good = (f"<p>Le gain{NB}: 0,5{NN}; la «{NB}recette{NB}»{NN}? À 10:30, voir "
+            f"<a href='https://example.org/a:b'>https://example.org/a:b</a>, doi:10.1115/1.3662552, "
+            f"filterpy 2.0.0, Durbin et Koopman (§{NB}5.2).</p><pre>x = 0.5 ; print('a : b')</pre><code>1e-05 :</code>"
+            f"<span class='math'>\\frac{{a}}{{b}} : 0.5</span>")
+    bad = ("<p>Le gain : 0.5 ; la « recette » ? Écart 1.2e-05 et \\frac{a}{b}.</p>"
+           "<div class='cell_input'><pre>kc.numbers.glue_number('x', 1.0)</pre></div>"
+           "<img src='a.png' alt='a.png'>")
+    context = browser.new_context()
+    page = context.new_page()
+    page.set_content(f"<main>{good}</main>")
+    assert page.evaluate(_PROSE) == {"tex": [], "english": [], "space": [], "guillemets": []}
+    assert page.evaluate(_GLUE_CELLS) == [] and page.evaluate(_IMAGES) == []
+    page.set_content(f"<main>{bad}</main>")
+    found = page.evaluate(_PROSE)
+    assert len(found["english"]) == 2 and len(found["space"]) == 3 and len(found["guillemets"]) == 2
+    assert len(found["tex"]) == 1
+    assert len(page.evaluate(_GLUE_CELLS)) == 1 and page.evaluate(_IMAGES) == ["a.png"]
+    assert _CONTROL.findall("x \\approx y") == [] and _CONTROL.findall("x \approx y") == ["\a"]
+    context.close()
+
+
 # --------------------------------------------------------------------------- chaque chapitre se manipule
 
 
@@ -379,7 +455,7 @@ def _toc_pages(root: Path) -> list[Path]:
 
     toc = yaml.safe_load((ROOT / "_toc.yml").read_text())
     files = [toc["root"]] + [c["file"] for part in toc["parts"] for c in part["chapters"]]
-    return [root / f"{f}.html" for f in files if Path(f).name != "references"]
+    return [root / f"{f}.html" for f in files if Path(f).name not in APPENDICES]
 
 
 def _plotted(page, k: int) -> dict:

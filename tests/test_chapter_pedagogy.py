@@ -18,10 +18,14 @@ ROOT = Path(__file__).resolve().parent.parent
 BOOK = ROOT / "book"
 
 
+#: Annexes du livre (ni objectifs, ni figure à curseurs, ni quiz).
+APPENDICES = {"references", "errata"}
+
+
 def _pages() -> list[str]:
     toc = yaml.safe_load((ROOT / "_toc.yml").read_text())
     files = [toc["root"]] + [c["file"] for part in toc["parts"] for c in part["chapters"]]
-    return [Path(f).name for f in files if Path(f).name != "references"]
+    return [Path(f).name for f in files if Path(f).name not in APPENDICES]
 
 
 PAGES = _pages()
@@ -72,17 +76,23 @@ def test_page_opens_with_objectives_and_prerequisites(page):
     text = _text(page)
     head = text[: text.index("\n## ")] if "\n## " in text else text
     assert ":::{admonition} Objectifs" in head, f"{page} : pas d'encadré « Objectifs » avant la première section"
-    assert ":::{admonition} Prérequis" in head, f"{page} : pas d'encadré « Prérequis » avant la première section"
+    # les prérequis : un encadré, ou un paragraphe « **Prérequis** » dans celui des objectifs
+    assert ":::{admonition} Prérequis" in head or "**Prérequis**" in head, f"{page} : pas de prérequis en tête"
     objectives = re.search(r":::\{admonition\} Objectifs\n:class: \w+\n(.*?)\n:::", head, re.S).group(1)
-    assert 2 <= objectives.count("\n- ") + 1 <= 5, f"{page} : deux à cinq objectifs"
+    assert 2 <= len(re.findall(r"^- ", objectives, re.M)) <= 6, f"{page} : deux à six objectifs"
 
 
 @pytest.mark.parametrize("page", PAGES)
 def test_page_closes_with_what_to_remember(page):
-    sections = [h for h in _h2(_text(page)) if h != "Bibliographie"]
-    assert sections[-1] == "À retenir", f"{page} : la dernière section est « {sections[-1]} »"
-    body = _text(page).split("## À retenir", 1)[1].split("\n## ", 1)[0]
-    assert 2 <= body.count("\n- ") <= 6, f"{page} : « À retenir » court (2 à 6 points)"
+    text = _text(page)
+    sections = [h for h in _h2(text) if h != "Bibliographie"]
+    box = re.search(r"^:::\{admonition\} À retenir\n:class: \w+\n(.*?)\n:::\s*$", text, re.M | re.S)
+    if box and text.rstrip().endswith(":::"):  # un encadré « À retenir » qui ferme la page
+        body = box.group(1)
+    else:
+        assert sections[-1] == "À retenir", f"{page} : la dernière section est « {sections[-1]} »"
+        body = text.split("## À retenir", 1)[1].split("\n## ", 1)[0]
+    assert 2 <= len(re.findall(r"^- ", body, re.M)) <= 7, f"{page} : « À retenir » court (2 à 7 points)"
 
 
 @pytest.mark.parametrize("page", PAGES)
@@ -98,8 +108,13 @@ def test_page_has_a_quiz_of_three_to_five_well_formed_questions(page):
     assert len({q["answer"] for q in questions}) >= 2, f"{page} : la bonne réponse est toujours la n° {questions[0]['answer']}"
 
 
-_SHOWN = re.compile(r'kc\.interactive\.(?:sliders\("([^"]+)"\)|(voltage|tag)_sliders\(\))')
-_LEGACY = {"voltage": "tension-curseurs", "tag": "tag-curseurs"}
+_LEGACY = {"voltage": "tension-curseurs", "tag": "tag-curseurs", "nile": "nil-curseurs",
+           "particle": "filtre-particulaire-curseurs", "banana_uncertainty": "ukf-banane-incertitude",
+           "banana_parameter": "ukf-banane-parametres"}
+_SHOWN = re.compile(r'kc\.interactive\.(?:sliders\("([^"]+)"\)|(' + "|".join(_LEGACY) + r')_sliders\(\))')
+#: Curseurs vivants des figures d'avant le registre, sous leur propre nom.
+_LIVE = {"tension-curseurs": "live_voltage_explorer()", "tag-curseurs": "live_tag_explorer()",
+         "nil-curseurs": "live_nile_explorer()"}
 
 
 @pytest.mark.parametrize("page", PAGES)
@@ -113,14 +128,15 @@ def test_page_shows_its_slider_figures_each_with_an_observation_box_and_live_cod
         call = f'sliders("{name}")' if name not in _LEGACY.values() else \
             {v: f"{k}_sliders()" for k, v in _LEGACY.items()}[name]
         after = text[text.index(call):]
-        box = re.search(r"::::\{admonition\} À observer\n:class: \w+\n(.*?)\n::::", after, re.S)
+        box = re.search(r"(:{3,4})\{admonition\} À observer\n:class: \w+\n(.*?)\n\1\n", after, re.S)
         assert box and after.index(box.group(0)) < 400, f"{page} : pas d'encadré « À observer » après {name}"
-        items = re.findall(r"^\d\. ", box.group(1), re.M)
-        dropdowns = re.findall(r"^   :::\{dropdown\} Explication$", box.group(1), re.M)
-        assert 2 <= len(items) <= 3 and len(dropdowns) == len(items), f"{page} : {name}, 2 ou 3 essais expliqués"
+        outside = re.sub(r"(```|:::)\{dropdown\}.*?\n\s*\1|:::\{admonition\}[^\n]*\n:class: dropdown.*?\n:::",
+                         "", box.group(2), flags=re.S)  # les essais, hors des explications
+        items = re.findall(r"^(?:\d\.|-) ", outside, re.M)
+        explained = re.findall(r"\{dropdown\}|:class: dropdown", box.group(2))
+        assert 2 <= len(items) <= 4 and explained, f"{page} : {name}, deux à quatre essais, expliqués en dépliant"
         # les curseurs vivants (Jupyter) sont montrés en code à recopier, jamais exécutés dans le livre
-        live = f'live_explorer("{name}")' if name not in _LEGACY.values() else \
-            {v: f"live_{k}_explorer()" for k, v in _LEGACY.items()}[name]
+        live = _LIVE.get(name, f'live_explorer("{name}")')
         blocks = re.findall(r"```python\n(.*?)```", text, re.S)
         assert any(live in b for b in blocks), f"{page} : curseurs vivants de {name} non montrés"
 

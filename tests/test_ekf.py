@@ -1,5 +1,5 @@
-"""EKF : contre filterpy (ExtendedKalmanFilter, UnscentedKalmanFilter), contre le KF sur un modèle affine,
-angles, mesures manquantes, entrées invalides."""
+"""EKF : contre filterpy (ExtendedKalmanFilter), contre le KF sur un modèle affine, angles, mesures
+manquantes, entrées invalides (l'UKF est testé dans ``test_unscented.py``)."""
 
 from __future__ import annotations
 
@@ -207,44 +207,6 @@ def test_bearing_innovation_is_wrapped():
     assert np.linalg.norm(bad.x[:, :2] - x_true[:, :2], axis=1).max() > 50.0  # mesuré : 77,6 m
 
 
-# --------------------------------------------------------------------------- UKF de filterpy
-
-
-def test_tag_ekf_and_ukf_rmse_are_of_the_same_order():
-    data = tag.tag_data()
-    ekf = tag.run_tag_ekf(data=data)
-    ukf = tag.run_tag_ukf(data=data)
-    r_ekf = tag.position_rmse(ekf.x, data.x_true)
-    r_ukf = tag.position_rmse(ukf.x, data.x_true)
-    assert 0.98 <= r_ekf / r_ukf <= 1.02  # mesuré : 0,9996 (5,98 cm contre 5,99 cm)
-    assert 0.05 < r_ekf < 0.07  # σ = 10 cm par distance, 4 ancres ; mesuré : 5,98 cm
-
-
-def test_ukf_on_linear_model_equals_kalman_filter():
-    """Transformée « unscented » exacte pour f, h linéaires : l'UKF redonne le KF.
-
-    Avec α = 1 (points sigma bien conditionnés) l'égalité tient à 1e-9 ; avec le réglage par défaut
-    α = 0,1 (poids W₀ ≈ −130), les arrondis amplifiés la limitent à environ 1e-7."""
-    rng = np.random.default_rng(11)
-    lin = random_model(rng, n=4, m=2, p=1)
-    u = rng.normal(size=50)
-    y = kc.simulate(lin, np.zeros(4), 50, u=u, rng=11).y
-    ref = kc.kalman_filter(lin, y, np.ones(4), 2 * np.eye(4), u=u)
-    model = kc.NonlinearModel.from_linear(lin)
-    ukf = kc.filterpy_unscented_filter(model, y, np.ones(4), 2 * np.eye(4), u=u, alpha=1.0)
-    np.testing.assert_allclose(ukf.x, ref.x, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(ukf.P, ref.P, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(ukf.x_pred, ref.x_pred, rtol=0, atol=1e-9)
-    default = kc.filterpy_unscented_filter(model, y, np.ones(4), 2 * np.eye(4), u=u)
-    np.testing.assert_allclose(default.x, ref.x, rtol=0, atol=1e-6)
-
-
-def test_ukf_handles_bearing_wrap():
-    x_true, y, x0, P0 = radar.radar_tracking_data()
-    ukf = kc.filterpy_unscented_filter(radar.radar_tracking_model(), y, x0, P0)
-    assert np.linalg.norm(ukf.x[10:, :2] - x_true[10:, :2], axis=1).max() < 1.0
-
-
 # --------------------------------------------------------------------------- scénario du tag
 
 
@@ -334,12 +296,6 @@ def test_error_runner_arguments():
         kc.ekf_predict(model, np.zeros(2), np.eye(2), u=np.ones(1))
 
 
-def test_ukf_refuses_non_additive_noise():
-    model = kc.NonlinearModel(**_good(), h_noise_jacobian=np.eye(1))
-    with pytest.raises(kc.KalmanInputError, match=r"bruits additifs"):
-        kc.filterpy_unscented_filter(model, np.ones(3), np.zeros(2), np.eye(2))
-
-
 # --------------------------------------------------------------------------- formules du chapitre
 
 
@@ -353,63 +309,3 @@ def test_tag_process_noise_is_the_chapter_formula():
         idx = [axis, axis + 2]
         expected[np.ix_(idx, idx)] = blk
     np.testing.assert_allclose(Q, expected, rtol=0, atol=1e-15)
-
-
-def test_merwe_sigma_points_match_chapter_formulas():
-    """Points sigma et poids de van der Merwe, tels qu'écrits dans « Pour aller plus loin »."""
-    from filterpy.kalman import MerweScaledSigmaPoints
-
-    n, alpha, beta, kappa = 4, 0.1, 2.0, -1.0
-    lam = alpha**2 * (n + kappa) - n
-    pts = MerweScaledSigmaPoints(n, alpha=alpha, beta=beta, kappa=kappa)
-    Wm = np.full(2 * n + 1, 1 / (2 * (n + lam)))
-    Wc = Wm.copy()
-    Wm[0] = lam / (n + lam)
-    Wc[0] = lam / (n + lam) + 1 - alpha**2 + beta
-    np.testing.assert_allclose(pts.Wm, Wm)
-    np.testing.assert_allclose(pts.Wc, Wc)
-    rng = np.random.default_rng(0)
-    L = rng.normal(size=(n, n))
-    P, x = L @ L.T + np.eye(n), rng.normal(size=n)
-    chi = pts.sigma_points(x, P)
-    # χ₀ = x̂, χ_{i} − x̂ = −(χ_{n+i} − x̂) : colonnes d'une racine carrée de (n + λ)P
-    np.testing.assert_allclose(chi[0], x)
-    D = chi[1:n + 1] - x
-    np.testing.assert_allclose(chi[n + 1:] - x, -D, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(D.T @ D, (n + lam) * P, rtol=0, atol=1e-9)
-    # la transformée restitue moyenne et covariance
-    np.testing.assert_allclose(Wm @ chi, x, rtol=0, atol=1e-10)
-    np.testing.assert_allclose((chi - x).T @ np.diag(Wc) @ (chi - x), P, rtol=0, atol=1e-9)
-
-
-def test_ukf_step_matches_chapter_formulas():
-    """Un pas prédiction + correction écrit d'après les formules du chapitre = UKF de filterpy (tag)."""
-    data = tag.tag_data(3)
-    model = tag.tag_model()
-    n, alpha, beta, kappa = 4, 0.1, 2.0, -1.0
-    lam = alpha**2 * (n + kappa) - n
-    Wm = np.full(2 * n + 1, 1 / (2 * (n + lam)))
-    Wc = Wm.copy()
-    Wm[0] = lam / (n + lam)
-    Wc[0] = lam / (n + lam) + 1 - alpha**2 + beta
-    x, P = np.array(data.x0), np.array(data.P0)
-    ours = []
-    for y in data.y:
-        L = np.linalg.cholesky((n + lam) * P)
-        chi = np.vstack([x, x + L.T, x - L.T])  # lignes : χ₀, χ₁..χₙ, χₙ₊₁..χ₂ₙ
-        chi_m = np.array([model.transition(c, None) for c in chi])
-        x_m = Wm @ chi_m
-        P_m = (chi_m - x_m).T @ np.diag(Wc) @ (chi_m - x_m) + model.Q
-        L = np.linalg.cholesky((n + lam) * P_m)  # points sigma retirés de (x̂⁻, P⁻)
-        chi_t = np.vstack([x_m, x_m + L.T, x_m - L.T])
-        Z = np.array([model.observe(c) for c in chi_t])
-        y_hat = Wm @ Z
-        S = (Z - y_hat).T @ np.diag(Wc) @ (Z - y_hat) + model.R
-        Pxy = (chi_t - x_m).T @ np.diag(Wc) @ (Z - y_hat)
-        K = Pxy @ np.linalg.inv(S)
-        x = x_m + K @ (y - y_hat)
-        P = P_m - K @ S @ K.T
-        ours.append(x)
-    ref = kc.filterpy_unscented_filter(model, data.y, data.x0, data.P0, alpha=alpha, beta=beta, kappa=kappa)
-    np.testing.assert_allclose(np.array(ours), ref.x, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(P, ref.P[-1], rtol=0, atol=1e-9)

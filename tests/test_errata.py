@@ -392,3 +392,215 @@ def test_001_22_third_welch_bishop_run_is_psi_1e_minus_4():
     K50 = {R: kc.kalman_filter(kc.scenarios.constant_voltage_model(R=R), z, 0.0, 1.0).K[-1, 0, 0] for R in (1e-4, 1e-5)}
     assert K50[1e-4] == pytest.approx(0.270, abs=5e-4)  # ALGORITHMS.md §7(e)
     assert abs(K50[1e-5] - 0.270) > 0.2  # la valeur imprimée Ψ = 10⁻⁵ donne une autre figure
+
+
+# =========================================================================== errata des autres documents
+# 000 : tableaux du KF, de l'EKF et de l'EKF itéré ; 002 : notes du SRIF ; 004 : notes SE(3).
+# Chaque formule corrigée est vérifiée contre une référence indépendante ; la formule imprimée est
+# montrée fausse quand elle a un sens calculable.
+
+
+def test_000_1_prior_covariance_uses_the_forward_transition_and_the_previous_noise():
+    """P(k|k-1) = Φ(k,k-1) P Φᵀ(k,k-1) + G(k-1)Q(k-1)Gᵀ(k-1) : comparée à filterpy (predict) et à la
+    covariance empirique de x(k) − Φ(k,k-1)x(k-1) quand Q varie d'un pas à l'autre."""
+    from filterpy.kalman import KalmanFilter
+
+    A = np.array([[1.0, 0.5], [0.0, 0.8]])  # Φ(k, k-1), non orthogonale
+    P = np.array([[0.3, 0.1], [0.1, 0.2]])
+    G = np.array([[0.5], [1.0]])
+    Q_prev, Q_now = np.array([[0.04]]), np.array([[0.25]])  # Q(k-1) ≠ Q(k)
+    correct = A @ P @ A.T + G @ Q_prev @ G.T
+    f = KalmanFilter(dim_x=2, dim_z=1)
+    f.F, f.P, f.Q, f.x = A, P.copy(), G @ Q_prev @ G.T, np.zeros((2, 1))
+    f.predict()
+    np.testing.assert_allclose(correct, f.P, rtol=1e-14, atol=0)
+    A_back = np.linalg.inv(A)  # Φ(k-1, k) du tableau : la transition à rebours
+    printed = A_back @ P @ A_back.T + G @ Q_now @ G.T
+    assert np.abs(printed - correct).max() > 0.1
+    # le bruit qui fait passer de k-1 à k est u(k-1), de covariance Q(k-1) : simulation
+    rng = np.random.default_rng(0)
+    x_prev = rng.multivariate_normal(np.zeros(2), P, size=200_000)
+    noise = rng.standard_normal((200_000, 1)) * np.sqrt(Q_prev[0, 0])
+    x_now = x_prev @ A.T + noise @ G.T
+    empirical = np.cov(x_now.T)
+    assert np.abs(empirical - correct).max() < 0.01
+    assert np.abs(empirical - (A @ P @ A.T + G @ Q_now @ G.T)).max() > 0.1
+
+
+def test_000_2_noise_covariance_needs_a_transpose():
+    """E[v(k)vᵀ(l)] = R δ_kl (une matrice) ; le produit sans transposée, lu comme vᵀv, ne donne que le
+    scalaire tr R."""
+    R = np.array([[0.04, 0.015], [0.015, 0.02]])
+    model = kc.LinearGaussianModel(A=np.eye(2), C=np.eye(2), Q=1e-4 * np.eye(2), R=R)
+    sim = kc.simulate(model, np.zeros(2), 100_000, rng=3)
+    v = sim.y - sim.x  # bruits de mesure
+    same = v.T @ v / len(v)
+    lagged = v[1:].T @ v[:-1] / (len(v) - 1)
+    np.testing.assert_allclose(same, R, atol=2e-3)
+    assert np.abs(lagged).max() < 2e-3  # δ_kl : rien entre deux instants
+    inner = np.mean(np.sum(v * v, axis=1))
+    assert inner == pytest.approx(np.trace(R), rel=0.02) and np.ndim(inner) == 0
+
+
+def test_000_3_posterior_error_is_centred_given_the_measurements():
+    """E[x(k-1) − x̂(k-1|k-1) | y(1), …, y(k-1)] = 0 : sur des tirages, l'erreur a posteriori est
+    centrée et non corrélée à chacune des mesures passées (projection orthogonale)."""
+    model = kc.scenarios.constant_voltage_model(Q=1e-3, R=0.01)
+    runs, T = 4000, 8
+    rng = np.random.default_rng(7)
+    errors, ys = [], []
+    for _ in range(runs):
+        x0 = rng.normal(0.0, 1.0)
+        sim = kc.simulate(model, [x0], T, rng=rng)
+        res = kc.kalman_filter(model, sim.y, 0.0, 1.0)
+        errors.append(sim.x[-1, 0] - res.x[-1, 0])
+        ys.append(sim.y[:, 0])
+    e, Y = np.array(errors), np.array(ys)
+    P_T = kc.kalman_filter(model, Y[0], 0.0, 1.0).P[-1, 0, 0]
+    assert abs(e.mean()) < 4 * np.sqrt(P_T / runs)
+    corr = [np.corrcoef(e, Y[:, j])[0, 1] for j in range(T)]
+    assert max(abs(c) for c in corr) < 4 / np.sqrt(runs)
+
+
+def test_000_4_jacobian_of_the_observation_is_a_matrix():
+    """∇g joue le rôle de la **matrice** H(k) : pour une mesure à m = 2 composantes, elle est m × n."""
+    p = np.array([3.0, 4.0])
+    J = kc.numerical_jacobian(kc.scenarios.radar.range_bearing, p)
+    assert J.shape == (2, 2)
+    np.testing.assert_allclose(J, kc.scenarios.radar.range_bearing_jacobian(p), atol=1e-8)
+
+
+def test_000_11_ekf_prediction_applies_the_nonlinear_f():
+    """La prédiction x̂(k|k-1) de l'EKF est f(x̂(k-1|k-1)) : on applique f elle-même, pas sa jacobienne."""
+    model = kc.scenarios.radar.radar_tracking_model()
+    x = np.array([40.0, -3.0, -2.0, 1.5])
+    P = np.diag([4.0, 4.0, 1.0, 1.0])
+    pred = kc.ekf_predict(model, x, P)
+    np.testing.assert_allclose(pred.x, model.transition(x), rtol=0, atol=1e-12)
+
+
+def _controlled_drag_model(dt=0.5, c=0.05):
+    """Dynamique non linéaire (traînée) avec une commande d'accélération u (2,)."""
+    def f(x, u):
+        p, v = x[:2], x[2:]
+        return np.concatenate([p + dt * v, v - dt * c * np.linalg.norm(v) * v + dt * u])
+
+    def h(x):
+        return np.array([np.hypot(x[0], x[1]), np.arctan2(x[1], x[0])])
+
+    return kc.NonlinearModel(f, h, Q=np.diag([1e-3, 1e-3, 1e-2, 1e-2]), R=np.diag([0.05**2, 0.01**2]),
+                             n_control=2, angle_indices=(1,))
+
+
+def test_002_1_srif_dynamics_takes_the_control_u():
+    """x(k+1) = f(k, x(k), u(k), v(k)) : le SRIF étendu propage avec la commande u(k) et redonne l'EKF
+    (même commande) ; sans la commande, l'estimation s'écarte."""
+    model = _controlled_drag_model()
+    rng = np.random.default_rng(4)
+    T = 40
+    u = 0.5 * np.column_stack([np.sin(0.2 * np.arange(T)), np.cos(0.3 * np.arange(T))])
+    x = np.array([-20.0, 5.0, 4.0, 1.0])
+    ys = []
+    for k in range(T):
+        x = model.transition(x, u[k]) + np.sqrt(np.diag(model.Q)) * rng.standard_normal(4)
+        ys.append(model.observe(x) + np.sqrt(np.diag(model.R)) * rng.standard_normal(2))
+    y = np.array(ys)
+    x0, P0 = np.array([-19.0, 4.0, 3.5, 1.2]), np.diag([4.0, 4.0, 1.0, 1.0])
+    esr = kc.extended_square_root_information_filter(model, y, x0, P0, u=u)
+    ekf = kc.extended_kalman_filter(model, y, x0, P0, u=u)
+    np.testing.assert_allclose(esr.x, ekf.x, rtol=1e-9, atol=1e-9)
+    without = kc.extended_square_root_information_filter(model, y, x0, P0, u=np.zeros_like(u))
+    assert np.abs(without.x - esr.x).max() > 0.1
+
+
+def test_002_2_linearisation_carries_the_noise_not_the_state():
+    """f(x, u) + Γv ≈ f(x̂, u) + F(x − x̂) + Γv, à l'ordre 2 près ; le terme « Γx » des notes laisse une
+    erreur d'ordre 1 (elle ne diminue pas avec l'écart x − x̂)."""
+    model = _controlled_drag_model()
+    Gamma = np.array([[0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    x_hat, u, v = np.array([3.0, 1.0, 2.0, -1.0]), np.array([0.2, -0.1]), np.array([0.3, -0.2])
+    F = kc.numerical_jacobian(lambda x: model.transition(x, u), x_hat)
+    direction = np.array([1.0, -0.5, 0.3, 0.2])
+    errors_ok, errors_printed = [], []
+    for eps in (1e-1, 1e-2, 1e-3):
+        x = x_hat + eps * direction
+        truth = model.transition(x, u) + Gamma @ v
+        corrected = model.transition(x_hat, u) + F @ (x - x_hat) + Gamma @ v
+        printed = model.transition(x_hat, u) + F @ (x - x_hat) + Gamma @ x[2:]
+        errors_ok.append(np.abs(truth - corrected).max())
+        errors_printed.append(np.abs(truth - printed).max())
+    assert errors_ok[1] / errors_ok[0] < 0.02 and errors_ok[2] / errors_ok[1] < 0.02  # ordre 2
+    assert min(errors_printed) > 0.5
+
+
+def test_002_6_the_noise_is_rotated_by_the_same_orthogonal_T_a():
+    """[w̄_v(k); w̄_x(k+1)] = T_a(k) [w_v(k); w_x(k)] : la QR qui triangularise le pré-tableau, appliquée
+    au bruit unitaire, le laisse de covariance I, et son bloc a priori est celui de kc.srif_predict."""
+    rng = np.random.default_rng(5)
+    n, q = 3, 2
+    A = np.eye(n) + 0.2 * rng.standard_normal((n, n))
+    Gamma = rng.standard_normal((n, q))
+    model = kc.LinearGaussianModel(A, np.eye(n)[:1], Gamma @ Gamma.T, [[0.1]])
+    R_xx = np.triu(rng.standard_normal((n, n))) + 3 * np.eye(n)
+    z_x = rng.standard_normal(n)
+    M = R_xx @ np.linalg.inv(A)
+    pre = np.block([[np.eye(q), np.zeros((q, n))], [-M @ Gamma, M]])
+    Qm, Rm = scipy.linalg.qr(pre)
+    T_a = Qm.T  # T_a · pré-tableau = triangulaire
+    np.testing.assert_allclose(T_a @ pre, Rm, atol=1e-12)
+    w = rng.standard_normal((q + n, 200_000))
+    w_bar = T_a @ w
+    np.testing.assert_allclose(np.cov(w_bar), np.eye(q + n), atol=0.02)
+    R_bar = kc.srif_predict(model, R_xx, z_x, method="inverse")[0]
+    # même information a priori (à des signes de lignes près) : R̄ᵀR̄ identiques
+    np.testing.assert_allclose(Rm[q:, q:].T @ Rm[q:, q:], R_bar.T @ R_bar, rtol=1e-10, atol=1e-10)
+
+
+def test_002_8_whitening_with_the_transposed_factor_is_wrong_unless_inverse():
+    """Blanchir par R_a^{-T} donne une covariance I ; par R_a^T, la covariance R_aᵀ R R_a n'est ni I ni,
+    en général, R² (elle vaut R² seulement si R est diagonale)."""
+    R = np.array([[0.04, 0.012], [0.012, 0.02]])
+    Ra = scipy.linalg.cholesky(R, lower=False)  # R = Raᵀ Ra
+    white = np.linalg.solve(Ra.T, np.linalg.solve(Ra.T, R).T)  # Ra^{-T} R Ra^{-1}
+    np.testing.assert_allclose(white, np.eye(2), atol=1e-12)
+    printed = Ra.T @ R @ Ra
+    assert np.abs(printed - np.eye(2)).max() > 0.9
+    assert np.abs(printed - R @ R).max() > 1e-5
+    np.testing.assert_allclose(printed, Ra.T @ Ra.T @ Ra @ Ra, rtol=1e-12)
+    D = np.diag([0.04, 0.02])
+    Da = scipy.linalg.cholesky(D, lower=False)
+    np.testing.assert_allclose(Da.T @ D @ Da, D @ D, rtol=1e-12)
+
+
+def test_004_5_rotation_derivative_is_a_limit_at_zero():
+    """∂(R Exp(θ) p)/∂θ = −R[p]× est la limite du quotient quand θ → 0 ; quand |θ| grandit, le quotient
+    ne converge pas (Exp(θ) est périodique : à |θ| = 2π il revient à I)."""
+    from kalman_course.geometry.lie import hat3, so3_exp
+
+    R = so3_exp([0.3, -0.4, 0.2])
+    p = np.array([0.5, -1.0, 2.0])
+    expected = -R @ hat3(p)
+    for k in range(3):
+        e = np.eye(3)[k]
+        for t in (1e-6, 1e-7):
+            quotient = (R @ so3_exp(t * e) @ p - R @ p) / t
+            np.testing.assert_allclose(quotient, expected[:, k], atol=1e-5)
+        full_turn = (R @ so3_exp(2 * np.pi * e) @ p - R @ p) / (2 * np.pi)
+        assert np.abs(full_turn).max() < 1e-12  # rien à voir avec −R[p]×
+        assert np.abs(expected[:, k]).max() > 0.3
+
+
+def test_004_6_lie_jacobian_uses_ominus():
+    """J = lim (f(X ⊕ τ) ⊖ f(X))/τ : pour la mesure de la caméra (valeurs dans ℝ^2N, ⊖ = −), le quotient
+    avec ⊖ redonne camera_measurement_jacobian ; avec ⊕ (= +) il diverge quand τ → 0."""
+    p = kc.scenarios.camera_target.camera_target_problem()
+    T, pts, cam = p.T_true, p.points, p.camera
+    H = kc.camera_measurement_jacobian(T, pts, cam, "right")
+    h0 = kc.camera_measurement(T, pts, cam)
+    for j in range(6):
+        tau = 1e-6
+        step = np.zeros(6)
+        step[j] = tau
+        moved = kc.camera_measurement(kc.oplus(T, step), pts, cam)
+        np.testing.assert_allclose((moved - h0) / tau, H[:, j], rtol=1e-4, atol=1e-3)
+        assert np.abs((moved + h0) / tau).min() > 1e6  # « ⊕ » : pas de limite

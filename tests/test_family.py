@@ -3,7 +3,9 @@ linéaire est comparé à la référence indépendante (la boucle ``predict()``/
 mêmes données — mêmes ``x`` et ``P`` à 1e-9, même traitement des mesures manquantes, mêmes erreurs
 d'entrée (elles viennent du moteur commun).
 
-Les filtres à venir (UKF du paquet, filtre particulaire, lisseurs) rejoignent la liste ``FILTERS``.
+Les filtres de Monte-Carlo (filtre particulaire, EnKF) rejoignent la famille **statistiquement** (liste
+``STOCHASTIC``) : même moteur, mêmes erreurs d'entrée, mêmes pas sans mesure, et une moyenne qui tend vers
+celle du filtre de Kalman quand le nombre de particules ou de membres croît.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ def _nonlinear(model):
 
 
 def _ukf(model, y, x0, P0, u=None):
-    return kc.filterpy_unscented_filter(_nonlinear(model), y, x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0)
+    return kc.unscented_kalman_filter(_nonlinear(model), y, x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0)
 
 
 FILTERS = [
@@ -51,7 +53,7 @@ FILTERS = [
         m, y, x0, P0, u, method="joint")),
     Member("SRIF étendu", lambda m, y, x0, P0, u=None: kc.extended_square_root_information_filter(
         _nonlinear(m), y, x0, P0, u)),
-    Member("UKF de filterpy (α=1, β=2, κ=0)", _ukf, partial_rows=False),
+    Member("UKF (α=1, β=2, κ=0)", _ukf),
 ]
 IDS = [f.name for f in FILTERS]
 
@@ -113,13 +115,6 @@ def test_partial_rows_use_only_the_observed_components(member):
         np.testing.assert_allclose(res.P[k], f.P, **TOL)
     assert res.observed[4].tolist() == [True, False] and np.isnan(res.innovation[4, 1])
     assert np.all(res.K[4][:, 1] == 0) and np.isnan(res.S[4][1]).all()
-
-
-def test_ukf_adapter_refuses_partial_rows_with_a_french_error():
-    model, y, x0, P0, u = _case(5, 3, 2, 1, T=10)
-    y[4, 1] = np.nan
-    with pytest.raises(kc.KalmanInputError, match="partiellement manquantes"):
-        _ukf(model, y, x0, P0, u)
 
 
 def test_nis_is_consistent_on_every_member():
@@ -229,3 +224,113 @@ def test_runs_bad_input():
     runs = kc.kalman_filter_runs(model, np.zeros((3, 5)), np.zeros(2), np.eye(2))
     with pytest.raises(kc.KalmanInputError, match="« i » doit être un indice de tirage"):
         runs.run(3)
+
+
+# --------------------------------------------------------------------------- filtres de Monte-Carlo
+
+
+STOCHASTIC = [
+    Member("filtre particulaire", lambda m, y, x0, P0, u=None, size=4000, rng=0: kc.particle_filter(
+        _nonlinear(m), y, x0, P0, u, n_particles=size, rng=rng)),
+    Member("EnKF", lambda m, y, x0, P0, u=None, size=4000, rng=0: kc.ensemble_kalman_filter(
+        _nonlinear(m), y, x0, P0, u, n_members=size, rng=rng)),
+]
+STOCHASTIC_IDS = [f.name for f in STOCHASTIC]
+
+
+@pytest.mark.parametrize("member", STOCHASTIC, ids=STOCHASTIC_IDS)
+def test_monte_carlo_members_tend_to_the_kalman_filter(member):
+    """Même modèle linéaire que la suite, lignes manquantes et partielles comprises : écart à la moyenne et
+    à la covariance du KF petit devant l'écart-type du KF, et divisé par environ 2 quand N est multiplié
+    par 4 (erreur de Monte-Carlo en 1/√N ; moyenne sur 3 graines)."""
+    model, y, x0, P0, u = _case(3, 3, 2, 1, T=40)
+    y[[5, 6]] = np.nan
+    y[[12, 20], 1] = np.nan
+    ref = kc.kalman_filter(model, y, x0, P0, u)
+    std = np.sqrt(ref.P.diagonal(axis1=1, axis2=2))
+    errors = []
+    for size in (500, 8000):
+        e = [np.sqrt(np.mean(((member.run(model, y, x0, P0, u, size=size, rng=s).x - ref.x) / std) ** 2))
+             for s in range(3)]
+        errors.append(np.mean(e))
+    assert errors[1] < 0.1
+    assert 2.5 < errors[0] / errors[1] < 6.5, errors  # √16 = 4
+
+
+@pytest.mark.parametrize("member", STOCHASTIC, ids=STOCHASTIC_IDS)
+def test_monte_carlo_missing_rows_are_prediction_only(member):
+    model, y, x0, P0, u = _case(3, 3, 2, 1, T=20)
+    y[[0, 7, 8]] = np.nan
+    res = member.run(model, y, x0, P0, u, size=200)
+    for k in (0, 7, 8):
+        np.testing.assert_array_equal(res.x[k], res.x_pred[k])
+        assert not res.observed[k].any() and np.all(res.K[k] == 0) and np.isnan(res.innovation[k]).all()
+    assert res.n_iter.tolist() == [0 if k in (0, 7, 8) else 1 for k in range(20)]
+
+
+@pytest.mark.parametrize("member", STOCHASTIC, ids=STOCHASTIC_IDS)
+@pytest.mark.parametrize("bad, message", BAD_INPUTS)
+def test_monte_carlo_members_share_the_engine_errors(member, bad, message):
+    model, y, x0, P0, u = _case(1, 3, 2, 1, T=5)
+    args = dict(y=y, x0=x0, P0=P0, u=u)
+    args.update(bad)
+    with pytest.raises(kc.KalmanInputError, match=message):
+        member.run(model, args["y"], args["x0"], args["P0"], args["u"], size=10)
+
+
+@pytest.mark.parametrize("member", STOCHASTIC, ids=STOCHASTIC_IDS)
+def test_monte_carlo_members_refuse_a_control_without_B(member):
+    model, y, x0, P0, _ = _case(1, 3, 2, 0, T=5)
+    with pytest.raises(kc.KalmanInputError, match="« u » est fourni mais le modèle n'a pas de matrice de commande B"):
+        member.run(model, y, x0, P0, np.zeros((5, 1)), size=10)
+
+
+def test_engine_random_generator_and_step_outputs_hooks():
+    """Le moteur passe un seul générateur à toutes les étapes d'une famille ``stochastic`` (même graine →
+    mêmes tirages) et empile, temps en premier, les sorties de ``step_outputs``."""
+    from kalman_course.filters.engine import Correction, FilterFamily, run_filter
+
+    seen = []
+
+    def prior(model, x0, P0, rng):
+        return (np.asarray(x0, float), np.asarray(P0, float), rng.random())
+
+    def predict(model, state, u, rng):
+        seen.append(rng)
+        return (state[0], state[1], rng.random())
+
+    def update(model, state, y, idx, rng):
+        return (state[0] + y[:1], state[1], rng.random()), Correction(np.zeros((1, 1)), y - state[0], np.eye(1))
+
+    family = FilterFamily(
+        name="filtre de test", model_type=kc.LinearGaussianModel, prior=prior, predict=predict, update=update,
+        moments=lambda s: (s[0], s[1]), stochastic=True,
+        step_outputs=lambda s: {"draw": s[2], "pair": np.array([s[2], 2 * s[2]])},
+    )
+    model = kc.LinearGaussianModel(1.0, [[1.0]], 1.0, 1.0)
+    y = np.array([1.0, np.nan, 2.0])
+    with pytest.raises(TypeError):  # FilterResult n'a pas de champ « draw » : la famille doit le déclarer
+        run_filter(family, model, y, [0.0], [[1.0]], rng=5)
+
+    from dataclasses import dataclass
+
+    @dataclass(frozen=True, eq=False, repr=False)
+    class Extra(kc.FilterResult):
+        draw: np.ndarray | None = None
+        pair: np.ndarray | None = None
+
+    import dataclasses
+    family = dataclasses.replace(family, result_type=Extra)
+    seen.clear()
+    a = run_filter(family, model, y, [0.0], [[1.0]], rng=5)
+    assert len({id(g) for g in seen}) == 1 and len(seen) == 3  # un seul générateur, passé à chaque pas
+    b = run_filter(family, model, y, [0.0], [[1.0]], rng=np.random.default_rng(5))
+    g = np.random.default_rng(5)
+    draws = g.random(6)  # prior, predict, update, predict, predict, update
+    np.testing.assert_array_equal(a.draw, [draws[2], draws[3], draws[5]])
+    np.testing.assert_array_equal(a.draw, b.draw)
+    assert a.pair.shape == (3, 2)
+    with pytest.raises(kc.KalmanInputError, match="« rng » doit être une graine entière"):
+        run_filter(family, model, y, [0.0], [[1.0]])
+    with pytest.raises(kc.KalmanInputError, match="« rng » est fourni, mais le filtre de Kalman ne tire rien"):
+        run_filter(kc.filters.kalman.kalman_family(), model, y, [0.0], [[1.0]], rng=1)

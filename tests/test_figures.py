@@ -109,6 +109,20 @@ def test_cli_list_names_every_figure():
     assert proc.returncode == 0, proc.stderr
     listed = [line.split()[0] for line in proc.stdout.splitlines() if line.strip()]
     assert listed == NAMES
+    for line, name in zip(proc.stdout.splitlines(), NAMES):  # description et titre du chapitre
+        spec = REGISTRY[name]
+        assert spec.title in line and f"« {spec.chapter_title} »" in line and f"book/{spec.chapter}.md" in line
+
+
+def test_cli_parallel_jobs_write_the_same_bytes_as_one_process(tmp_path):
+    names = ["gain-limites", "tension-estimation", "tests-nis"]
+    only = [arg for name in names for arg in ("--only", name)]
+    serial = _run("--out", str(tmp_path / "un"), "--jobs", "1", *only)
+    parallel = _run("--out", str(tmp_path / "deux"), "--jobs", "2", *only)
+    assert serial.returncode == 0 and parallel.returncode == 0, serial.stderr + parallel.stderr
+    assert "2 processus" in parallel.stderr and "100%" in parallel.stderr
+    for name in names:
+        assert (tmp_path / "un" / f"{name}.png").read_bytes() == (tmp_path / "deux" / f"{name}.png").read_bytes()
 
 
 def test_cli_writes_every_figure_with_a_progress_bar(tmp_path):
@@ -142,6 +156,8 @@ def test_cli_only_all_formats_and_same_data_twice(tmp_path):
         (["--format", "png,gif"], "format(s) inconnu(s) : gif"),
         (["--format", ","], "format(s) inconnu(s)"),
         (["--only", "pas-une-figure"], "figure(s) inconnue(s) : pas-une-figure"),
+        (["--jobs", "-1"], "entier ≥ 0 attendu"),
+        (["--jobs", "deux"], "entier ≥ 0 attendu"),
         ([], "l'option --out DOSSIER est obligatoire"),
     ],
 )

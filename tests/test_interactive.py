@@ -162,15 +162,15 @@ def test_precompute_grid_is_generic():
 @pytest.mark.parametrize(
     "value, unit, text",
     [
-        (1e-5, "V²", "1·10⁻⁵ V²"),
-        (10**-4.5, "V²", "3,16·10⁻⁵ V²"),
-        (0.01, "V²", "0,01 V²"),
-        (0.0316227766, "V²", "0,0316 V²"),
-        (1.0, "V²", "1 V²"),
-        (100.0, "V²", "100 V²"),
-        (9.9999e-5, "", "1·10⁻⁴"),
-        (2.5e4, "m", "2,5·10⁴ m"),
-        (0.5, "m/s²", "0,5 m/s²"),
+        (1e-5, "V²", "1\u202f×\u202f10⁻⁵\u00a0V²"),
+        (10**-4.5, "V²", "3,16\u202f×\u202f10⁻⁵\u00a0V²"),
+        (0.01, "V²", "0,01\u00a0V²"),
+        (0.0316227766, "V²", "0,0316\u00a0V²"),
+        (1.0, "V²", "1\u00a0V²"),
+        (100.0, "V²", "100\u00a0V²"),
+        (9.9999e-5, "", "1\u202f×\u202f10⁻⁴"),
+        (2.5e4, "m", "2,5\u202f×\u202f10⁴\u00a0m"),
+        (0.5, "m/s²", "0,5\u00a0m/s²"),
     ],
 )
 def test_format_value_writes_real_values_in_french(value, unit, text):
@@ -215,7 +215,7 @@ def test_static_figure_html_carries_the_exact_grid(vgrid):
     assert PLOTTED_SOURCE in text
     for label in vgrid.axes[0].labels() + vgrid.axes[1].labels():
         assert label in text  # le curseur affiche les vraies valeurs
-    for words in ("itération n (sans unité)", "tension (V)", "Pₙ (V²)", "Kₙ (sans unité)", "Φ — bruit d'état"):
+    for words in ("itération n (sans unité)", "tension (V)", "Pₙ (V²)", "Kₙ (sans unité)", "Φ — bruit d’état"):
         assert words in text
 
 
@@ -393,3 +393,24 @@ def test_bad_grid_and_figure_arguments():
         ki.StaticSliders(grid, (panel,), "t (s)", fixed={"t": t})
     with pytest.raises(kc.KalmanInputError, match="min_exp"):
         ki.LogParameter("Q", "Φ", "V²", 1e-3, 0.0, -2.0)
+
+
+def test_static_sliders_print_the_default_run_with_a_caption():
+    """Le PDF n'anime pas de curseurs : la figure fournit un PNG (position par défaut) et une légende.
+    Le PNG trace l'exécution que donne un appel direct du filtre (voltage_run), pas la grille."""
+    from kalman_course.interactive.static import CAPTION_ATTRIBUTE
+    from kalman_course.interactive.voltage import VOLTAGE_Q, VOLTAGE_R
+
+    figure = kc.interactive.voltage_sliders()
+    data, metadata = figure._repr_mimebundle_()
+    assert data["image/png"][:8] == b"\x89PNG\r\n\x1a\n"
+    assert metadata["image/png"]["width"] > 0 and metadata["image/png"]["height"] > 0
+    assert f'{CAPTION_ATTRIBUTE}="' in data["text/html"]
+    expected = kc.interactive.voltage_run(VOLTAGE_Q, VOLTAGE_R)
+    plotted = {line.get_label(): np.asarray(line.get_ydata()) for ax in figure.default_figure().axes
+               for line in ax.get_lines()}
+    np.testing.assert_allclose(plotted["estimation x̂ₙ"], expected["x"], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(plotted["Pₙ (a posteriori)"], expected["P"], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(plotted["gain Kₙ"], expected["K"], rtol=0, atol=1e-15)
+    caption = figure.caption()
+    assert "Φ = 1\u202f×\u202f10⁻⁵\u00a0V²" in caption and "Ψ = 0,01\u00a0V²" in caption and "15 × 15" in caption

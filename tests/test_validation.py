@@ -214,10 +214,10 @@ def test_position_rmse_wants_state_sequences():
         tag.position_rmse(np.zeros((5, 4)), np.zeros((6, 4)))
 
 
-def test_filterpy_ukf_with_singular_P0_is_a_french_error():
+def test_ukf_with_singular_P0_is_a_french_error():
     m = kc.NonlinearModel.from_linear(kc.LinearGaussianModel(np.eye(2), np.eye(2), np.eye(2), np.eye(2)))
     with pytest.raises(KalmanInputError, match="« P0 » doit être définie positive"):
-        kc.filterpy_unscented_filter(m, np.zeros((3, 2)), np.zeros(2), np.zeros((2, 2)))
+        kc.unscented_kalman_filter(m, np.zeros((3, 2)), np.zeros(2), np.zeros((2, 2)), alpha=1.0, kappa=0.0)
 
 
 def test_shapes_read_well_in_messages():

@@ -170,6 +170,12 @@ class NonlinearModel:
         Dimension ``p`` de la commande (0 : pas de commande, ``f`` reçoit ``u = None``).
     angle_indices : indices des composantes de la mesure qui sont des angles (rad) : leurs résidus
         :math:`y - h(x)` sont ramenés dans :math:`(-\pi, \pi]`.
+    vectorized : bool
+        ``True`` si ``f`` et ``h`` acceptent aussi une **pile** d'états ``X`` de forme (N, n) (une ligne par
+        état) et renvoient alors (N, n) et (N, m) ; elles doivent toujours accepter un seul état (n,).
+        Les filtres à points (points sigma de l'UKF, particules, membres d'un ensemble) propagent alors
+        tous leurs points en **un** appel (:meth:`transition_many`, :meth:`observe_many`). ``False``
+        (défaut) : un appel par point, même résultat, plus lent.
 
     Chaque appel de ``f``, ``h`` et des jacobiennes passe par les méthodes du modèle, qui vérifient la
     forme et la finitude du résultat et lèvent une :class:`KalmanInputError` qui nomme la fonction fautive.
@@ -187,6 +193,7 @@ class NonlinearModel:
     n_obs: int
     n_control: int
     angle_indices: tuple[int, ...]
+    vectorized: bool
 
     def __init__(
         self,
@@ -203,7 +210,10 @@ class NonlinearModel:
         n_obs: int | None = None,
         n_control: int = 0,
         angle_indices: Sequence[int] = (),
+        vectorized: bool = False,
     ) -> None:
+        if not isinstance(vectorized, (bool, np.bool_)):
+            raise KalmanInputError(f"« vectorized » doit être un booléen (True ou False) ; reçu {vectorized!r}.")
         for name, func in (("f", f), ("h", h)):
             if not callable(func):
                 raise KalmanInputError(
@@ -248,6 +258,7 @@ class NonlinearModel:
         object.__setattr__(self, "n_obs", int(m))
         object.__setattr__(self, "n_control", int(n_control))
         object.__setattr__(self, "angle_indices", angles)
+        object.__setattr__(self, "vectorized", bool(vectorized))
 
     # ------------------------------------------------------------------ évaluations vérifiées
 
@@ -258,6 +269,24 @@ class NonlinearModel:
     def observe(self, x: np.ndarray) -> np.ndarray:
         r""":math:`h(x)`, forme (m,), vérifiée (taille, valeurs finies)."""
         return _checked_vector("h", call_user_function("h", self.h, x), self.n_obs, "m", x)
+
+    def transition_many(self, X: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
+        r""":math:`f(x_i, u)` pour chaque ligne :math:`x_i` de ``X`` (N, n) ; renvoie (N, n), vérifié.
+
+        Modèle vectorisé : un seul appel ``f(X, u)`` ; sinon un appel par ligne."""
+        if not self.vectorized:
+            return np.array([self.transition(x, u) for x in X]).reshape(X.shape[0], self.n_state)
+        out = call_user_function("f", self.f, X, (u,))
+        return _checked_stack("f", out, X, self.n_state, "n")
+
+    def observe_many(self, X: np.ndarray) -> np.ndarray:
+        r""":math:`h(x_i)` pour chaque ligne :math:`x_i` de ``X`` (N, n) ; renvoie (N, m), vérifié.
+
+        Modèle vectorisé : un seul appel ``h(X)`` ; sinon un appel par ligne."""
+        if not self.vectorized:
+            return np.array([self.observe(x) for x in X]).reshape(X.shape[0], self.n_obs)
+        out = call_user_function("h", self.h, X)
+        return _checked_stack("h", out, X, self.n_obs, "m")
 
     def transition_jacobian(self, x: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
         r""":math:`F = J^A = \partial f/\partial x` en :math:`(x, u)`, forme (n, n) (analytique ou différences centrées)."""
@@ -318,14 +347,15 @@ class NonlinearModel:
         (jacobiennes constantes :math:`A` et :math:`C`). Sert à vérifier que l'EKF redonne alors le KF."""
         A, B, C = model.A, model.B, model.C
 
-        def f(x, u):
-            return A @ x if u is None else A @ x + B @ u
+        def f(x, u):  # x (n,) ou pile (N, n) : x Aᵀ (+ uᵀ Bᵀ) ligne par ligne
+            return x.dot(A.T) if u is None else x.dot(A.T) + B.dot(u)
 
-        return cls(f, lambda x: C @ x, model.Q, model.R, f_jacobian=A, h_jacobian=C,
-                   n_control=model.n_control)
+        return cls(f, lambda x: x.dot(C.T), model.Q, model.R, f_jacobian=A, h_jacobian=C,
+                   n_control=model.n_control, vectorized=True)
 
     def __repr__(self) -> str:
-        return f"NonlinearModel(n={self.n_state}, m={self.n_obs}, p={self.n_control})"
+        extra = ", vectorisé" if self.vectorized else ""
+        return f"NonlinearModel(n={self.n_state}, m={self.n_obs}, p={self.n_control}{extra})"
 
 
 def _dimension(name: str, given: Any, noise_jac: Any, noise_name: str, default: int) -> int:
@@ -361,6 +391,25 @@ def _checked_vector(name: str, value: Any, size: int, letter: str, x: np.ndarray
             f"dimension de {what}) ; elle a renvoyé la forme {arr.shape}."
         )
     return check_finite_output(name, arr, x)
+
+
+def _checked_stack(name: str, value: Any, X: np.ndarray, size: int, letter: str) -> np.ndarray:
+    """Résultat d'une fonction vectorisée sur une pile ``X`` (N, n) : forme (N, size), valeurs finies."""
+    arr = np.asarray(value, dtype=float)
+    N = X.shape[0]
+    if arr.ndim == 1 and size == 1 and arr.shape == (N,):
+        arr = arr.reshape(N, 1)
+    if arr.shape != (N, size):
+        raise KalmanInputError(
+            f"La fonction « {name} » d'un modèle vectorisé (vectorized=True) doit renvoyer la forme "
+            f"({N}, {size}) pour une pile de {N} états ({letter} = {size}) ; elle a renvoyé la forme {arr.shape}. "
+            f"Écrivez-la avec x[..., i] (composantes sur le dernier axe) ou construisez le modèle avec "
+            f"vectorized=False."
+        )
+    if not np.isfinite(arr).all():
+        bad = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
+        check_finite_output(name, arr[bad], X[bad])
+    return arr
 
 
 def _checked_matrix(name: str, value: Any, x: np.ndarray, args: tuple, shape: tuple[int, int]) -> np.ndarray:

@@ -174,9 +174,10 @@ class FilterHistory:
             self.innovation[k, idx] = corr.innovation
             self.S[k][np.ix_(idx, idx)] = corr.S
 
-    def result(self, result_type: type | None = None) -> "FilterResult":
+    def result(self, result_type: type | None = None, **extra) -> "FilterResult":
+        """Le résultat figé ; ``extra`` : champs propres à ``result_type`` (sorties empilées de chaque pas)."""
         cls = FilterResult if result_type is None else result_type
         return cls(
             x=self.x, P=self.P, x_pred=self.x_pred, P_pred=self.P_pred, K=self.K,
-            innovation=self.innovation, S=self.S, observed=self.observed, n_iter=self.n_iter,
+            innovation=self.innovation, S=self.S, observed=self.observed, n_iter=self.n_iter, **extra,
         )

@@ -237,12 +237,14 @@ class ChiSquareTest:
     consistent: bool
 
     def __str__(self) -> str:
+        from ..numbers import format_spec as fr  # Babel, chargé à l'affichage seulement
+
         verdict = "cohérent" if self.consistent else "incohérent : hypothèse rejetée"
         return (
             f"Test du χ² sur la {self.quantity} moyenne ({self.n_values} valeur(s))\n"
-            f"  moyenne {self.statistic:.4g}, attendu {self.expected:.4g} "
+            f"  moyenne {fr(self.statistic, '.4g')} ; attendu {fr(self.expected, '.4g')} "
             f"(somme à {self.dof} degrés de liberté)\n"
-            f"  bande à {100 * self.level:g} % : [{self.lower:.4g} ; {self.upper:.4g}], p = {self.p_value:.3g}\n"
+            f"  bande à {fr(100 * self.level, 'g')} % : [{fr(self.lower, '.4g')} ; {fr(self.upper, '.4g')}] ; p = {fr(self.p_value, '.3g')}\n"
             f"  → {verdict}"
         )
 
@@ -405,12 +407,14 @@ class WhitenessTest:
         freeze_fields(self, "autocorrelation", "ljung_box", "component_p_values")
 
     def __str__(self) -> str:
+        from ..numbers import format_spec as fr  # Babel, chargé à l'affichage seulement
+
         verdict = "blanches" if self.white else "non blanches : hypothèse rejetée"
         return (
             f"Test de blancheur ({self.n_values} innovations, décalages 1 à {self.lags[-1]})\n"
-            f"  {100 * self.fraction_outside:.1f} % des autocorrélations hors de ± {self.band:.3g}\n"
-            f"  Ljung–Box Q = {self.statistic:.4g} ({self.dof} degrés de liberté), p = {self.p_value:.3g}\n"
-            f"  → {verdict} (niveau {100 * self.level:g} %)"
+            f"  {fr(100 * self.fraction_outside, '.1f')} % des autocorrélations hors de ± {fr(self.band, '.3g')}\n"
+            f"  Ljung–Box Q = {fr(self.statistic, '.4g')} ({self.dof} degrés de liberté) ; p = {fr(self.p_value, '.3g')}\n"
+            f"  → {verdict} (niveau {fr(100 * self.level, 'g')} %)"
         )
 
 
@@ -489,14 +493,16 @@ class CentringTest:
         freeze_fields(self, "mean", "t_statistic", "t_p_values")
 
     def __str__(self) -> str:
+        from ..numbers import format_spec as fr  # Babel, chargé à l'affichage seulement
+
         verdict = "centrées" if self.centred else "non centrées : hypothèse rejetée"
-        means = ", ".join(f"{v:.3g}" for v in self.mean)
+        means = " ; ".join(fr(v, ".3g") for v in self.mean)  # « ; » : la virgule est décimale
         return (
             f"Test de centrage ({self.n_values} innovations)\n"
             f"  moyenne ({means})\n"
-            f"  T² de Hotelling = {self.hotelling:.4g}, F({self.dof[0]}, {self.dof[1]}) = {self.f_statistic:.4g}, "
-            f"p = {self.p_value:.3g}\n"
-            f"  → {verdict} (niveau {100 * self.level:g} %)"
+            f"  T² de Hotelling = {fr(self.hotelling, '.4g')}, F({self.dof[0]}, {self.dof[1]}) = {fr(self.f_statistic, '.4g')} ; "
+            f"p = {fr(self.p_value, '.3g')}\n"
+            f"  → {verdict} (niveau {fr(100 * self.level, 'g')} %)"
         )
 
 

@@ -14,9 +14,13 @@ from . import consistency  # noqa: F401  (chapitre « Vérifier les hypothèses 
 from . import ekf  # noqa: F401  (chapitre « Dynamique non linéaire — le filtre de Kalman étendu »)
 from . import tag  # noqa: F401  (chapitre « Exemple — suivi d'un tag radio (UWB) »)
 from . import iekf  # noqa: F401  (chapitre « Filtre de Kalman étendu itéré »)
-from . import ukf  # noqa: F401  (chapitre « Pour aller plus loin » : UKF de filterpy)
+from . import unscented  # noqa: F401  (chapitre « Le filtre de Kalman sans parfum (UKF) »)
+from . import particle  # noqa: F401  (chapitre « Le filtre particulaire »)
+from . import ensemble  # noqa: F401  (chapitre « Le filtre de Kalman d'ensemble (EnKF) »)
 from . import srif  # noqa: F401  (chapitre « Filtre d'information en racine carrée (SRIF) »)
 from . import se3  # noqa: F401  (chapitre « EKF itéré sur SE(3) : pose d'une cible vue par une caméra »)
+from . import smoothing  # noqa: F401  (chapitre « Lissage : le lisseur RTS »)
+from . import likelihood  # noqa: F401  (chapitre « Apprendre Q et R : vraisemblance et données réelles »)
 from ._registry import REGISTRY, FigureSpec, draw, names, new_figure, register
 
 __all__ = ["REGISTRY", "FigureSpec", "draw", "names", "new_figure", "register"]

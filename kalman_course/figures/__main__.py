@@ -1,9 +1,17 @@
-"""Commande : ``python -m kalman_course.figures --out DOSSIER [--format png,svg,pdf] [--only NOM] [--list]``."""
+"""Commande : ``python -m kalman_course.figures --out DOSSIER [--format png,svg,pdf] [--only NOM] [--jobs N]``
+ou ``--list`` (nom, description et chapitre de chaque figure).
+
+Chaque figure est dessinée et écrite par un seul processus (``--jobs N`` en répartit les figures
+sur ``N`` processus) ; une barre de progression (tqdm, sur la sortie d'erreur) compte les figures.
+"""
 
 from __future__ import annotations
 
 import argparse
+import multiprocessing
+import os
 import sys
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import matplotlib
@@ -29,6 +37,16 @@ class _FrenchParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog} : erreur : {message}\n")
 
 
+def _jobs(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"entier ≥ 0 attendu (0 : un processus par cœur) ; reçu « {text} »")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _FrenchParser(
         prog="python -m kalman_course.figures",
@@ -46,16 +64,47 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--only", action="append", metavar="NOM", help="ne produire que cette figure (répétable)")
     parser.add_argument("--dpi", type=int, default=150, help="résolution des PNG (défaut : 150)")
-    parser.add_argument("--list", action="store_true", help="lister les figures disponibles et quitter")
+    parser.add_argument(
+        "-j",
+        "--jobs",
+        type=_jobs,
+        default=1,
+        metavar="N",
+        help="nombre de processus qui dessinent en parallèle (défaut : 1 ; 0 : un par cœur)",
+    )
+    parser.add_argument(
+        "--list",
+        action="store_true",
+        help="lister les figures (nom, description, chapitre) et quitter",
+    )
     return parser
+
+
+def write_figure(name: str, out: Path, formats: list[str], dpi: int) -> int:
+    """Dessine la figure ``name`` et l'écrit dans ``out`` dans chaque format ; renvoie le nombre de
+    fichiers écrits. Date retirée des métadonnées et identifiants SVG déterministes (réglage local à
+    cet appel) : deux régénérations écrivent les mêmes octets, quel que soit le processus."""
+    with matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
+        fig = draw(name)
+        for fmt in formats:
+            fig.savefig(out / f"{name}.{fmt}", dpi=dpi, metadata=_FIXED_METADATA[fmt])
+    return len(formats)
+
+
+def _pool(jobs: int) -> ProcessPoolExecutor:
+    # « fork » : les processus héritent du paquet déjà importé (démarrage immédiat) ; sinon « spawn ».
+    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context(method))
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.list:
+        width = max(len(name) for name in REGISTRY)
         for spec in REGISTRY.values():
-            print(f"{spec.name:32s} [{spec.chapter}] {spec.title}")
+            print(f"{spec.name:{width}s}  {spec.description}  — chapitre « {spec.chapter_title} » "
+                  f"(book/{spec.chapter}.md)")
         return 0
     if args.out is None:
         parser.error("l'option --out DOSSIER est obligatoire (ou --list)")
@@ -68,15 +117,18 @@ def main(argv: list[str] | None = None) -> int:
     if missing:
         parser.error(f"figure(s) inconnue(s) : {', '.join(missing)} (voir --list)")
     args.out.mkdir(parents=True, exist_ok=True)
+    jobs = min(args.jobs or os.cpu_count() or 1, len(selected))
     written = 0
-    # Date retirée des métadonnées et identifiants SVG déterministes (réglage local à cette boucle) :
-    # deux régénérations écrivent les mêmes octets.
-    with matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
+    if jobs == 1:
         for name in tqdm(selected, desc="figures", unit="fig", file=sys.stderr):
-            fig = draw(name)
-            for fmt in formats:
-                fig.savefig(args.out / f"{name}.{fmt}", dpi=args.dpi, metadata=_FIXED_METADATA[fmt])
-                written += 1
+            written += write_figure(name, args.out, formats, args.dpi)
+    else:
+        with _pool(jobs) as pool:
+            futures = [pool.submit(write_figure, name, args.out, formats, args.dpi) for name in selected]
+            with tqdm(total=len(futures), desc=f"figures ({jobs} processus)", unit="fig", file=sys.stderr) as bar:
+                for future in as_completed(futures):
+                    written += future.result()
+                    bar.update()
     print(f"{written} fichier(s) écrit(s) dans {args.out}")
     return 0
 

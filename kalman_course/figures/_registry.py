@@ -9,8 +9,31 @@ from typing import Callable
 from matplotlib.figure import Figure
 
 from ..core.validation import KalmanInputError
+from ..numbers import french_figure
 
-__all__ = ["CourseFigure", "FigureSpec", "REGISTRY", "register", "draw", "names", "new_figure"]
+__all__ = ["CHAPTER_TITLES", "CourseFigure", "FigureSpec", "REGISTRY", "register", "draw", "names", "new_figure"]
+
+#: Titre de chaque chapitre (nom du fichier ``book/<nom>.md`` → titre de niveau 1), pour
+#: ``python -m kalman_course.figures --list`` ; ``tests/test_book.py`` vérifie qu'ils suivent le livre.
+CHAPTER_TITLES: dict[str, str] = {
+    "controle-systeme": "Contrôle d'un système dynamique",
+    "estimateur": "Construction d'un estimateur",
+    "predicteur-correcteur": "Le filtre prédicteur–correcteur",
+    "gain-optimal": "Dynamique de l'erreur et gain optimal",
+    "tension-constante": "Exemple — estimation d'une tension constante",
+    "pratique-synthese": "Implémentation pratique et synthèse",
+    "tests-statistiques": "Vérifier les hypothèses : tests statistiques",
+    "ekf": "Dynamique non linéaire — le filtre de Kalman étendu",
+    "suivi-tag": "Exemple — suivi d'un tag radio (UWB)",
+    "ekf-itere": "Filtre de Kalman étendu itéré",
+    "ukf": "Le filtre de Kalman sans parfum (UKF)",
+    "filtre-particulaire": "Le filtre particulaire",
+    "enkf": "Le filtre de Kalman d'ensemble (EnKF)",
+    "lissage": "Lissage : le lisseur de Rauch–Tung–Striebel",
+    "vraisemblance": "Apprendre Q et R : vraisemblance et données réelles",
+    "srif": "Filtre d'information en racine carrée (SRIF)",
+    "ekf-itere-se3": "EKF itéré sur SE(3) : pose d'une cible vue par une caméra",
+}
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).
 DISPLAY_DPI = 144
@@ -39,6 +62,17 @@ class FigureSpec:
     title: str
     build: Callable[[], Figure]
 
+    @property
+    def description(self) -> str:
+        """Ce que montre la figure, en français (son titre dans le registre)."""
+        return self.title
+
+    @property
+    def chapter_title(self) -> str:
+        """Titre du chapitre qui montre la figure (le nom de fichier s'il n'est pas dans
+        :data:`CHAPTER_TITLES`)."""
+        return CHAPTER_TITLES.get(self.chapter, self.chapter)
+
 
 REGISTRY: dict[str, FigureSpec] = {}
 
@@ -61,14 +95,19 @@ def names() -> list[str]:
 
 
 def draw(name: str) -> Figure:
-    """Construit la figure ``name`` (une nouvelle ``matplotlib.figure.Figure``, sans état global pyplot)."""
+    """Construit la figure ``name`` (une nouvelle ``matplotlib.figure.Figure``, sans état global pyplot).
+
+    Graduations (virgule décimale, puissances de dix) et textes (espaces insécables) sont mis à la
+    française par :func:`kalman_course.numbers.french_figure` : une seule fois ici, pour toutes les figures."""
     try:
         spec = REGISTRY[name]
     except KeyError:
         raise KalmanInputError(
             f"Figure inconnue « {name} ». Figures disponibles : {', '.join(REGISTRY)}."
         ) from None
-    return spec.build()
+    figure = spec.build()
+    french_figure(figure)
+    return figure
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 7.0, height: float = 3.6, **kwargs):

@@ -17,6 +17,7 @@ from ..diagnostics.consistency import (
     whiteness_test,
 )
 from ..scenarios.engine import CONSISTENCY_MC_RUNS, CONSISTENCY_MC_STEPS, ENGINE_DT, consistency_monte_carlo, consistency_runs
+from ..numbers import format_spec as fr
 from ._registry import new_figure, register
 
 CHAPTER = "tests-statistiques"
@@ -71,8 +72,8 @@ def nis_figure():
         lo, hi = chi2_band(2, values.size)
         ax.axhspan(step_lo, step_hi, color="0.88", label=r"95 % d'une $\chi^2_2$ (un pas)")
         ax.plot(t, values, ".", ms=2.5, color=_COLORS[name], label=r"NIS$_n$")
-        ax.axhline(values.mean(), color=_COLORS[name], lw=1.8, label=f"moyenne = {values.mean():.2f}")
-        ax.axhspan(lo, hi, color="tab:green", alpha=0.35, label=f"bande de la moyenne [{lo:.2f} ; {hi:.2f}]")
+        ax.axhline(values.mean(), color=_COLORS[name], lw=1.8, label=f"moyenne = {fr(values.mean(), '.2f')}")
+        ax.axhspan(lo, hi, color="tab:green", alpha=0.35, label=f"bande de la moyenne [{fr(lo, '.2f')} ; {fr(hi, '.2f')}]")
         ax.set_yscale("log")
         ax.set_ylim(1e-3, 1e4)
         ax.set_ylabel("NIS (sans unité)")
@@ -89,7 +90,7 @@ def nees_figure():
     fig, ax = new_figure(width=7.0, height=3.8)
     lo, hi = chi2_band(2, CONSISTENCY_MC_RUNS)
     t = ENGINE_DT * np.arange(1, CONSISTENCY_MC_STEPS + 1)
-    ax.axhspan(lo, hi, color="tab:green", alpha=0.3, label=f"bande à 95 % de la moyenne [{lo:.2f} ; {hi:.2f}]")
+    ax.axhspan(lo, hi, color="tab:green", alpha=0.3, label=f"bande à 95 % de la moyenne [{fr(lo, '.2f')} ; {fr(hi, '.2f')}]")
     ax.axhline(2.0, color="0.3", lw=0.8, ls="--", label="espérance d = 2 (dimension de l'état)")
     for name, run in runs.items():
         ax.plot(t, run.nees.mean(axis=0), lw=1.4, color=_COLORS[name], label=_TITLES[name].split(" (")[0])
@@ -113,7 +114,7 @@ def autocorrelation_figure():
     fig, axes = new_figure(3, 1, width=7.0, height=7.2, sharex=True, sharey=True)
     for ax, name in zip(axes, names):
         test = whiteness_test(results[name], MAX_LAG)
-        ax.axhspan(-test.band, test.band, color="0.85", label=f"± 1,96/√T = ± {test.band:.3f}")
+        ax.axhspan(-test.band, test.band, color="0.85", label=f"± 1,96/√T = ± {fr(test.band, '.3f')}")
         for i, (offset, marker) in enumerate(((-0.15, "o"), (0.15, "s"))):
             ax.vlines(test.lags + offset, 0.0, test.autocorrelation[i], color=_COLORS[name], lw=1.2,
                       alpha=1.0 if i == 0 else 0.55)
@@ -121,7 +122,7 @@ def autocorrelation_figure():
                     alpha=1.0 if i == 0 else 0.55, label=f"composante {i + 1} (capteur {'moteur' if i == 0 else 'air'})")
         ax.axhline(0.0, color="0.3", lw=0.8)
         ax.set_ylabel("autocorrélation (sans unité)")
-        ax.set_title(f"{_TITLES[name]} — Ljung–Box p = {test.p_value:.2g}", fontsize=10)
+        ax.set_title(f"{_TITLES[name]} — Ljung–Box p = {fr(test.p_value, '.2g')}", fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="upper right", ncol=3)
     axes[0].set_ylim(-0.45, 0.75)

@@ -7,6 +7,7 @@ import numpy as np
 from ..filters.extended import ekf_predict
 from ..core.models import NonlinearModel
 from ._geometry import draw_ellipse
+from ..numbers import format_spec as fr
 from ._registry import new_figure, register
 
 CHAPTER = "ekf"
@@ -63,7 +64,7 @@ def ekf_linearisation():
     ax1.set_ylabel("y (m)")
     ax1.set_title(
         f"Après : $f(r, \\theta) = (r\\cos\\theta, r\\sin\\theta)$ — biais de la moyenne "
-        f"{np.linalg.norm(mc_mean - pred.x):.2f} m".replace(".", ","),
+        f"{fr(np.linalg.norm(mc_mean - pred.x), '.2f')} m",
         fontsize=10,
     )
     ax1.grid(alpha=0.3)

@@ -19,9 +19,9 @@ def iekf_iterations():
     p = it.problem
     fig, (ax, ac) = new_figure(1, 2, width=9.5, height=5.4, gridspec_kw={"width_ratios": [1.2, 1]})
 
-    # plan : courbes de niveau du coût J(x)
-    xs = np.linspace(7.0, 10.6, 200)
-    ys = np.linspace(-0.5, 3.9, 200)
+    # plan : courbes de niveau du coût J(x), sur une grille de 4 cm (100 × 100 évaluations de map_cost)
+    xs = np.linspace(7.0, 10.6, 100)
+    ys = np.linspace(-0.5, 3.9, 100)
     J = np.array([[map_cost(p.model, [x, y], p.x_pred, p.P_pred, p.y) for x in xs] for y in ys])
     levels = [1, 3, 10, 30, 100, 300, 1000, 3000]
     cs = ax.contour(xs, ys, J, levels=levels, cmap="viridis_r", linewidths=0.9)

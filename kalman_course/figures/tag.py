@@ -6,6 +6,7 @@ import numpy as np
 
 from ..scenarios.tag import TAG_ROOM, position_rmse, run_tag_ekf, tag_data, tag_ranges_jacobian
 from ._geometry import draw_ellipse
+from ..numbers import format_spec as fr
 from ._registry import new_figure, register
 
 CHAPTER = "suivi-tag"
@@ -43,7 +44,7 @@ def tag_track():
     ax.plot(*data.x0[:2], "o", color="tab:blue", mfc="white", ms=8, label=r"départ du filtre $\hat x_0$")
     ax.plot(*data.x_true[0, :2], "s", color="tab:green", ms=7, label="départ du tag")
     ax.set_title(f"Tag UWB, {data.t[-1]:.0f} s, 4 ancres, $\\sigma_r$ = 10 cm : "
-                 f"erreur quadratique moyenne {100 * rmse:.1f} cm")
+                 f"erreur quadratique moyenne {fr(100 * rmse, '.1f')} cm")
     ax.legend(loc="upper center", fontsize=8, ncol=3, bbox_to_anchor=(0.5, -0.1))
     return fig
 
@@ -91,7 +92,7 @@ def tag_jacobian():
     ax.plot(*x_pred[:2], "o", color="tab:blue", ms=6, label=r"prédiction $\hat p_{k\mid k-1}$")
     ax.plot([], [], "--", color="tab:red", lw=0.7, label="cercles des distances mesurées")
     ax.plot([], [], color="tab:purple", lw=1.8, label=r"lignes de $H_k$ (×1,5 m)")
-    ax.set_title(f"t = {data.t[k]:.1f} s : géométrie de la mesure".replace(".", ","), fontsize=10)
+    ax.set_title(f"t = {fr(data.t[k], '.1f')} s : géométrie de la mesure", fontsize=10)
     ax.legend(loc="lower center", fontsize=7, bbox_to_anchor=(0.5, -0.42), ncol=1)
 
     # zoom : covariance avant / après la correction, directions des ancres

@@ -6,6 +6,7 @@ import numpy as np
 
 from ..filters.kalman import kalman_filter
 from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
+from ..numbers import format_spec as fr
 from ._registry import new_figure, register
 
 CHAPTER = "tension-constante"
@@ -20,7 +21,7 @@ def _voltage_run(R: float, Q: float = 1e-5, P0: float = 1.0, n_steps: int = 50):
 def _voltage_panel(ax, R: float, title: str) -> None:
     z, result = _voltage_run(R)
     n = np.arange(1, z.size + 1)
-    ax.axhline(TRUE_VOLTAGE, color="tab:green", lw=1.5, label=f"valeur vraie x = {TRUE_VOLTAGE} V")
+    ax.axhline(TRUE_VOLTAGE, color="tab:green", lw=1.5, label=f"valeur vraie x = {fr(TRUE_VOLTAGE, 'g')} V")
     ax.plot(n, z, "+", color="tab:red", ms=7, label="mesures $y_n$")
     ax.plot(n, result.x[:, 0], color="tab:blue", lw=1.8, label=r"estimation $\hat x_n$")
     ax.set_xlabel("itération n (sans unité)")

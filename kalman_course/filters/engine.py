@@ -10,6 +10,16 @@ dans un :class:`FilterFamily` :
   composantes observées et ``idx`` leurs indices (``None`` : toutes) ;
 * ``moments(state)`` → :math:`(\hat x, P)` à ranger dans le résultat.
 
+Deux crochets facultatifs servent les filtres de Monte-Carlo (filtre particulaire, EnKF) :
+
+* ``stochastic=True`` : le moteur exige un générateur ``rng`` (graine entière ou
+  ``numpy.random.Generator``) et le passe à chaque étape en argument nommé (``prior(..., rng=g)``,
+  ``predict(..., rng=g)``, ``update(..., rng=g)``) : tous les tirages viennent de ce seul générateur, donc
+  même graine → même résultat ;
+* ``step_outputs(state)`` → dictionnaire ``nom → tableau`` lu après chaque pas (taille effective de
+  l'échantillon, incrément de log-vraisemblance, particules…) ; le moteur les empile, temps en premier,
+  et les passe au constructeur de ``result_type`` sous ces noms.
+
 Le moteur (:func:`run_filter`) fait, une fois pour toutes les familles, ce que faisait chaque boucle :
 vérifier le modèle, ``y``, ``u``, l'a priori ; traiter les mesures manquantes (ligne ``None``/``NaN`` :
 prédiction seule ; ligne partielle : correction avec les seules composantes observées) ; assembler le
@@ -20,12 +30,14 @@ d'entrée sont donc les mêmes pour tous les filtres.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
 from ..core.results import FilterHistory, FilterResult
-from ..core.validation import as_controls, as_gaussian, as_measurements, check_instance
+from ..core.simulation import as_generator
+from ..core.validation import KalmanInputError, as_controls, as_gaussian, as_measurements, check_instance
 
 __all__ = ["Correction", "FilterFamily", "run_filter", "observed_rows", "gaussian_prior", "gaussian_moments"]
 
@@ -50,7 +62,10 @@ class FilterFamily:
     ``model_hint`` : piste donnée quand le modèle n'est pas du bon type ; ``result_type`` : classe du
     résultat (une sous-classe de :class:`FilterResult`) ; ``state_shape(model)`` : forme de
     l'estimation rangée à chaque pas (``(n,)`` par défaut, ``(4, 4)`` pour une pose) ;
-    ``tangent_dim(model)`` : dimension de la covariance (``n`` par défaut, 6 pour SE(3)).
+    ``tangent_dim(model)`` : dimension de la covariance (``n`` par défaut, 6 pour SE(3)) ;
+    ``stochastic`` : les étapes tirent au hasard et reçoivent ``rng=`` (un ``numpy.random.Generator``) ;
+    ``step_outputs(state)`` : sorties supplémentaires de chaque pas (dictionnaire de tableaux), empilées
+    dans le temps et passées à ``result_type``.
     """
 
     name: str
@@ -63,6 +78,8 @@ class FilterFamily:
     result_type: type = FilterResult
     state_shape: Callable[[Any], tuple[int, ...]] = field(default=lambda model: (model.n_state,))
     tangent_dim: Callable[[Any], int] = field(default=lambda model: model.n_state)
+    stochastic: bool = False
+    step_outputs: Callable[[Any], dict[str, Any]] | None = None
 
 
 def gaussian_prior(model: Any, x0: Any, P0: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -80,7 +97,9 @@ def observed_rows(Y: np.ndarray) -> np.ndarray:
     return ~np.isnan(Y)
 
 
-def run_filter(family: FilterFamily, model: Any, y: Any, x0: Any, P0: Any, u: Any = None) -> FilterResult:
+def run_filter(
+    family: FilterFamily, model: Any, y: Any, x0: Any, P0: Any, u: Any = None, *, rng: Any = None
+) -> FilterResult:
     r"""Applique la famille ``family`` à toutes les mesures : pour chaque ``y[k]``, prédiction avec
     ``u[k]`` puis correction.
 
@@ -95,31 +114,57 @@ def run_filter(family: FilterFamily, model: Any, y: Any, x0: Any, P0: Any, u: An
         partiellement manquante n'utilise que ses composantes observées.
     x0, P0 : a priori, vérifiés et convertis par ``family.prior``.
     u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]`` sert à prédire vers ``y[k]``).
+    rng : graine entière ou ``numpy.random.Generator`` — obligatoire pour une famille ``stochastic``,
+        refusé pour les autres.
 
     Renvoie un ``family.result_type`` : ``x`` (T, …), ``P`` (T, d, d), ``x_pred``, ``P_pred``,
-    ``K`` (T, d, m), ``innovation`` (T, m), ``S`` (T, m, m), ``observed`` (T, m), ``n_iter`` (T,).
+    ``K`` (T, d, m), ``innovation`` (T, m), ``S`` (T, m, m), ``observed`` (T, m), ``n_iter`` (T,), et
+    les sorties de ``family.step_outputs`` empilées (T, …).
     """
     check_instance("model", model, family.model_type, family.model_hint)
+    if family.stochastic:
+        draws = {"rng": as_generator(rng)}
+    elif rng is not None:
+        raise KalmanInputError(f"« rng » est fourni, mais le {family.name} ne tire rien au hasard : retirez-le.")
+    else:
+        draws = {}
     m = model.n_obs
     Y = as_measurements("y", y, m)
     T = Y.shape[0]
     U = as_controls("u", u, T, model.n_control)
-    state = family.prior(model, x0, P0)
+    prior, predict, update = family.prior, family.predict, family.update
+    if draws:  # le générateur lié une fois pour toutes, pas à chaque appel
+        prior, predict, update = (partial(f, **draws) for f in (prior, predict, update))
+    state = prior(model, x0, P0)
     observed = observed_rows(Y)
     out = FilterHistory(T, family.state_shape(model), family.tangent_dim(model), m, observed)
     full = observed.all(axis=1)
     some = observed.any(axis=1)
+    extras: dict[str, list] = {}
+    # boucle chaude : références locales, pas d'appel superflu (moments identiques pour les filtres gaussiens)
+    moments = None if family.moments is gaussian_moments else family.moments
+    step_outputs = family.step_outputs
+    xs, Ps, xps, Pps = out.x, out.P, out.x_pred, out.P_pred
+    Ks, nus, Ss, n_iter = out.K, out.innovation, out.S, out.n_iter
     for k in range(T):
-        predicted = family.predict(model, state, None if U is None else U[k])
+        predicted = predict(model, state, None if U is None else U[k])
         if full[k]:
-            state, corr = family.update(model, predicted, Y[k], None)
-            out.correction(k, corr)
+            state, corr = update(model, predicted, Y[k], None)
+            Ks[k], nus[k], Ss[k], n_iter[k] = corr
         elif some[k]:
             idx = np.flatnonzero(observed[k])
-            state, corr = family.update(model, predicted, Y[k, idx], idx)
+            state, corr = update(model, predicted, Y[k, idx], idx)
             out.correction(k, corr, idx)
         else:
             state = predicted
-        out.store(k, *family.moments(predicted), *family.moments(state))
-    return out.result(family.result_type)
+        if moments is None:
+            xps[k], Pps[k] = predicted
+            xs[k], Ps[k] = state
+        else:
+            xps[k], Pps[k] = moments(predicted)
+            xs[k], Ps[k] = moments(state)
+        if step_outputs is not None:
+            for name, value in step_outputs(state).items():
+                extras.setdefault(name, []).append(value)
+    return out.result(family.result_type, **{name: np.stack(values) for name, values in extras.items()})
 

@@ -8,10 +8,15 @@ registre par :func:`register_sliders`) et rendue de deux façons :
 - :func:`live_explorer` (``kc.interactive.live_explorer("nom")``) : curseurs ipywidgets qui relancent le
   calcul du paquet ; il faut un noyau (Jupyter, Binder, Colab).
 
-:func:`voltage_sliders`, :func:`live_voltage_explorer`, :func:`tag_sliders`, :func:`live_tag_explorer`
-restent disponibles sous leur nom. :mod:`.grid` : les grilles précalculées (numpy seulement) ;
-:mod:`.sphinx_ext` : l'extension Sphinx qui sert BokehJS aux pages qui en ont besoin ; :mod:`.quiz` :
-la directive ``quiz`` des questionnaires corrigés dans la page.
+Les figures écrites avant le registre gardent leurs noms : :func:`voltage_sliders`,
+:func:`live_voltage_explorer` (tension constante), :func:`tag_sliders`, :func:`live_tag_explorer` (tag
+UWB), :func:`nile_sliders`, :func:`live_nile_explorer` (le Nil, chapitre « Lissage »),
+:func:`banana_uncertainty_sliders`, :func:`banana_parameter_sliders` (la « banane » de l'UKF) et
+:func:`particle_sliders` (le filtre particulaire) ; elles sont aussi au registre.
+
+:mod:`.grid` : les grilles précalculées (numpy seulement) ; :mod:`.sphinx_ext` : l'extension Sphinx qui
+sert BokehJS aux pages qui en ont besoin ; :mod:`.quiz` : la directive ``quiz`` des questionnaires
+corrigés dans la page.
 
 Seul ce sous-paquet importe bokeh et ipywidgets.
 """
@@ -30,8 +35,17 @@ from .grid import ParameterAxis, ParameterGrid, format_value, log_grid, precompu
 from .live import ChoiceParameter, LinearParameter, LiveExplorer, LogParameter
 from .spec import Glyph, Panel
 from .static import StaticSliders
+from .smoothing import live_nile_explorer, nile_axes, nile_grid, nile_slider_run, nile_sliders
 from .tag import live_tag_explorer, tag_axes, tag_grid, tag_run, tag_sliders
 from .voltage import live_voltage_explorer, voltage_axes, voltage_grid, voltage_run, voltage_sliders
+from .unscented import (
+    banana_parameter_grid,
+    banana_parameter_sliders,
+    banana_uncertainty_grid,
+    banana_uncertainty_sliders,
+)
+from .particle import particle_grid, particle_sliders
+
 # une figure à curseurs par chapitre (chaque module inscrit les siennes au registre)
 from . import intro  # noqa: F401  (introduction)
 from . import intuition  # noqa: F401  (« Le filtre de Kalman en images »)
@@ -41,8 +55,11 @@ from . import predictor  # noqa: F401  (« Le filtre prédicteur–correcteur »
 from . import gain  # noqa: F401  (« Dynamique de l'erreur et gain optimal »)
 from . import practice  # noqa: F401  (« Implémentation pratique et synthèse »)
 from . import consistency  # noqa: F401  (« Vérifier les hypothèses : tests statistiques »)
-from . import ekf  # noqa: F401  (« Le filtre de Kalman étendu » et « Pour aller plus loin »)
+from . import ekf  # noqa: F401  (« Le filtre de Kalman étendu »)
 from . import iekf  # noqa: F401  (« Filtre de Kalman étendu itéré »)
+from . import registered  # noqa: F401  (UKF, filtre particulaire, lissage : figures d'avant le registre)
+from . import ensemble  # noqa: F401  (« Le filtre de Kalman d'ensemble »)
+from . import likelihood  # noqa: F401  (« Apprendre Q et R »)
 from . import srif  # noqa: F401  (« Filtre d'information en racine carrée »)
 from . import se3  # noqa: F401  (« EKF itéré sur SE(3) »)
 
@@ -58,11 +75,22 @@ __all__ = [
     "SLIDER_FIGURES",
     "SliderSpec",
     "StaticSliders",
+    "banana_parameter_grid",
+    "banana_parameter_sliders",
+    "banana_uncertainty_grid",
+    "banana_uncertainty_sliders",
     "format_value",
     "live_explorer",
+    "live_nile_explorer",
     "live_tag_explorer",
     "live_voltage_explorer",
     "log_grid",
+    "nile_axes",
+    "nile_grid",
+    "nile_slider_run",
+    "nile_sliders",
+    "particle_grid",
+    "particle_sliders",
     "precompute_grid",
     "register_sliders",
     "slider_grid",

@@ -1,14 +1,11 @@
-r"""Curseurs des chapitres « Le filtre de Kalman étendu » et « Pour aller plus loin » : une loi gaussienne
-polaire transformée en coordonnées cartésiennes.
+r"""Curseurs du chapitre « Le filtre de Kalman étendu » : une loi gaussienne polaire transformée en
+coordonnées cartésiennes.
 
 :func:`~kalman_course.scenarios.polar.polar_transform` : nuage de Monte-Carlo, moyenne et covariance
-exactes (empiriques), approximation de l'EKF (tangente) et de l'UKF (points sigma). Les curseurs
-changent l'incertitude d'azimut :math:`\sigma_\theta` et de distance :math:`\sigma_r` ; la position par
-défaut (20°, 0,5 m) est la figure de linéarisation du chapitre de l'EKF.
-
-- ``ekf-linearisation-curseurs`` : le croissant et l'ellipse de l'EKF ; la fonction
-  :math:`x = r\cos\theta` et sa tangente en :math:`\hat\theta = 0`.
-- ``ukf-points-sigma`` : les mêmes lois et celle de l'UKF, avec les points sigma et leurs images.
+exactes (empiriques) et approximation de l'EKF (tangente). Les curseurs changent l'incertitude d'azimut
+:math:`\sigma_\theta` et de distance :math:`\sigma_r` ; la position par défaut (20°, 0,5 m) est la figure
+de linéarisation du chapitre. En haut, le croissant et l'ellipse de l'EKF ; en bas, la fonction
+:math:`x = r\cos\theta` et sa tangente en :math:`\hat\theta = 0`.
 """
 
 from __future__ import annotations
@@ -20,7 +17,7 @@ from .figure import SliderSpec, ellipse_outline, number, register_sliders
 from .grid import ParameterAxis
 from .spec import Glyph, Panel
 
-__all__ = ["BEARING_STDS", "RANGE_STDS", "SHOWN", "polar_axes", "ekf_run", "ekf_spec", "ukf_run", "ukf_spec"]
+__all__ = ["BEARING_STDS", "RANGE_STDS", "SHOWN", "polar_axes", "ekf_run", "ekf_spec"]
 
 #: Écarts-types d'azimut proposés (degrés) ; 20° est celui du chapitre.
 BEARING_STDS = (2.5, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0)
@@ -52,7 +49,7 @@ def _common(tr) -> dict[str, np.ndarray]:
         "exact_x": ex, "exact_y": ey, "ekf_x": kx, "ekf_y": ky,
         "exact_mean_x": tr.exact_mean[:1], "exact_mean_y": tr.exact_mean[1:],
         "ekf_mean_x": tr.ekf_mean[:1], "ekf_mean_y": tr.ekf_mean[1:],
-        "ekf_bias": np.array([tr.ekf_bias]), "ukf_bias": np.array([tr.ukf_bias]),
+        "ekf_bias": np.array([tr.ekf_bias]),
     }
 
 
@@ -73,7 +70,7 @@ def _ekf_readout(series, values) -> str:
             f"{number(series['ekf_mean_x'][0], 'm')}.")
 
 
-def _plane_glyphs(extra=()) -> tuple[Glyph, ...]:
+def _plane_glyphs() -> tuple[Glyph, ...]:
     return (
         Glyph("cloud_y", "scatter", "gray", f"{SHOWN} tirages transformés f(x)", x="cloud_x", marker="circle",
               size=3, alpha=0.5),
@@ -81,7 +78,7 @@ def _plane_glyphs(extra=()) -> tuple[Glyph, ...]:
         Glyph("ekf_y", "line", "firebrick", "EKF : f(x̂), J P Jᵀ (2σ)", x="ekf_x"),
         Glyph("exact_mean_y", "scatter", "black", "", x="exact_mean_x", marker="circle", size=8),
         Glyph("ekf_mean_y", "scatter", "firebrick", "", x="ekf_mean_x", marker="circle", size=8),
-    ) + tuple(extra)
+    )
 
 
 @register_sliders("ekf-linearisation-curseurs", chapter="ekf")
@@ -116,48 +113,4 @@ def ekf_spec() -> SliderSpec:
         ),
         fixed={"f_x": r_hat * np.cos(np.deg2rad(ANGLES))},
         readout=_ekf_readout,
-    )
-
-
-def ukf_run(bearing_std_deg: float, range_std: float) -> dict[str, np.ndarray]:
-    """Le plan avec l'ellipse de l'UKF, les points sigma et leurs images."""
-    tr = polar_transform(range_std, bearing_std_deg)
-    out = _common(tr)
-    ux, uy = ellipse_outline(tr.ukf_mean, tr.ukf_cov)
-    out.update({"ukf_x": ux, "ukf_y": uy, "ukf_mean_x": tr.ukf_mean[:1], "ukf_mean_y": tr.ukf_mean[1:],
-                "sigma_x": tr.sigma_mapped[:, 0], "sigma_y": tr.sigma_mapped[:, 1]})
-    return out
-
-
-def _ukf_readout(series, values) -> str:
-    return (f"Écart à la moyenne exacte : EKF {number(series['ekf_bias'][0], 'm')}, UKF "
-            f"{number(series['ukf_bias'][0], 'm')} (5 points sigma seulement, contre 3000 tirages).")
-
-
-@register_sliders("ukf-points-sigma", chapter="pour-aller-plus-loin")
-def ukf_spec() -> SliderSpec:
-    """La transformée « unscented » contre la linéarisation, au curseur."""
-    return SliderSpec(
-        name="ukf-points-sigma",
-        chapter="pour-aller-plus-loin",
-        title="Points sigma contre tangente : la même loi polaire (r̂ = 10 m, θ̂ = 0) transformée par f",
-        x_label="x (m)",
-        axes=polar_axes(),
-        run=ukf_run,
-        time=np.arange(SHOWN, dtype=float),
-        panels=(
-            Panel(
-                "Images des points sigma, ellipses de l'EKF et de l'UKF",
-                "y (m)",
-                _plane_glyphs((
-                    Glyph("ukf_y", "line", "seagreen", "UKF : transformée « unscented » (2σ)", x="ukf_x",
-                          width=2.5),
-                    Glyph("ukf_mean_y", "scatter", "seagreen", "", x="ukf_mean_x", marker="circle", size=8),
-                    Glyph("sigma_y", "scatter", "seagreen", "images des 5 points sigma f(χᵢ)", x="sigma_x",
-                          marker="diamond", size=11),
-                )),
-                **_PLANE,
-            ),
-        ),
-        readout=_ukf_readout,
     )

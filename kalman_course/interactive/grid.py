@@ -21,32 +21,19 @@ import numpy as np
 
 from ..core.results import freeze
 from ..core.validation import KalmanInputError, as_float_array, shape_text
+from ..numbers import format_number
 
 __all__ = ["AXIS_SCALES", "ParameterAxis", "ParameterGrid", "log_grid", "precompute_grid", "format_value"]
 
-_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
-
-
 def format_value(value: float, unit: str = "") -> str:
-    r"""Écriture française d'une valeur de paramètre : ``0,01 V²``, ``3,16·10⁻⁵ V²``, ``1·10⁻⁹ V²``.
+    r"""Écriture française d'une valeur de paramètre : « 0,01 V² », « 3,16 × 10⁻⁵ V² », « 1 × 10⁻⁹ V² ».
 
-    Trois chiffres significatifs, virgule décimale ; notation scientifique hors de
-    :math:`[10^{-2}, 10^{3})`.
+    Trois chiffres significatifs (zéros finals retirés), par :func:`kalman_course.numbers.format_number` ;
+    écriture :math:`m \times 10^{n}` hors de :math:`[10^{-2}, 10^{3})` ; unité après une espace insécable.
     """
     v = float(value)
-    if v == 0.0:
-        text = "0"
-    elif 1e-2 <= abs(v) < 1e3:
-        text = f"{v:.3g}".replace(".", ",")
-    else:
-        exponent = math.floor(math.log10(abs(v)))
-        mantissa = v / 10.0**exponent
-        if round(abs(mantissa), 2) >= 10.0:  # 9,996·10⁻⁵ arrondi → 1·10⁻⁴
-            mantissa /= 10.0
-            exponent += 1
-        m_text = f"{mantissa:.3g}".replace(".", ",")
-        text = f"{m_text}·10{str(exponent).translate(_SUPERSCRIPT)}"
-    return f"{text} {unit}".strip()
+    scientific = v != 0.0 and not 1e-2 <= abs(v) < 1e3
+    return format_number(v, significant=3, trim=True, scientific=scientific, unit=unit or None)
 
 
 #: Échelles possibles d'un axe : logarithmique (valeurs > 0, une variance), linéaire (un gain, un

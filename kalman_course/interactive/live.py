@@ -19,18 +19,14 @@ from typing import Callable, Mapping
 import ipywidgets as widgets
 import numpy as np
 
-from ..figures import new_figure
 from ..core.validation import KalmanInputError, as_float_array
-from .spec import Panel, check_columns
+from ..numbers import format_spec
+from .spec import Panel, check_columns, draw_panels, fill_glyph
 
 __all__ = ["LogParameter", "LinearParameter", "ChoiceParameter", "LiveExplorer"]
 
 #: Résolution du PNG affiché (pixels par pouce).
 LIVE_DPI = 100
-#: Styles de trait et marqueurs matplotlib des tracés décrits par :class:`~.spec.Glyph`.
-_MPL_DASH = {"solid": "-", "dashed": "--", "dotted": ":", "dashdot": "-."}
-_MPL_MARKER = {"cross": "+", "circle": "o", "square": "s", "diamond": "D", "triangle": "^", "x": "x",
-               "star": "*", "dot": "."}
 
 
 @dataclass(frozen=True)
@@ -56,7 +52,7 @@ class LogParameter:
         low, high = 10.0**self.min_exp, 10.0**self.max_exp
         if not (math.isfinite(v) and low <= v <= high):
             raise KalmanInputError(
-                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{low:.3g}, {high:.3g}] {self.unit}."
+                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{format_spec(low, '.3g')} ; {format_spec(high, '.3g')}] {self.unit}."
             )
 
     def slider(self) -> widgets.FloatLogSlider:
@@ -98,7 +94,7 @@ class LinearParameter:
         v = float(self.value)
         if not (math.isfinite(v) and self.low <= v <= self.high):
             raise KalmanInputError(
-                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{self.low:g} ; {self.high:g}] {self.unit}."
+                f"« {self.name} » = {self.value!r} est hors de la plage du curseur [{format_spec(self.low, '.3g')} ; {format_spec(self.high, '.3g')}] {self.unit}."
             )
 
     def slider(self) -> widgets.FloatSlider:
@@ -230,56 +226,15 @@ class LiveExplorer:
         return series
 
     def _draw(self, x_label: str):
-        height = sum(p.height for p in self.panels) / 80.0
-        shared = not any(p.own_x for p in self.panels)
-        fig, axes = new_figure(len(self.panels), 1, width=7.0, height=height, sharex=shared, squeeze=False)
-        axes = axes[:, 0]
-        lines: dict[str, list] = {}
         data = {"t": self.time, **self.fixed, **self.series}
-        for ax, panel in zip(axes, self.panels):
-            for glyph in panel.glyphs:
-                x = glyph.x
-                label = glyph.legend or None
-                if glyph.kind in ("hline", "vline"):
-                    draw = ax.axhline if glyph.kind == "hline" else ax.axvline
-                    draw(glyph.value, color=glyph.color, lw=1.5, ls=_MPL_DASH[glyph.dash], label=label)
-                    continue
-                if glyph.kind in ("area", "band"):
-                    self._fills.append((ax, glyph, self._fill(ax, glyph, data, label)))
-                    continue
-                if glyph.kind == "scatter":
-                    style = {"marker": _MPL_MARKER[glyph.marker], "ls": "none", "ms": glyph.size * 0.9}
-                else:
-                    style = {"lw": glyph.width * 0.9, "ls": _MPL_DASH[glyph.dash]}
-                (line,) = ax.plot(data[x], data[glyph.column], color=glyph.color, label=label, alpha=glyph.alpha,
-                                  **style)
-                line.kc_columns = (x, glyph.column)  # séries (abscisse, ordonnée) à relire au redessin
-                if glyph.column in self.series or x in self.series:
-                    lines.setdefault(glyph.column, []).append(line)
-            if panel.y_log:
-                ax.set_yscale("log")
-            if panel.x_log:
-                ax.set_xscale("log")
-            if panel.y_range is not None:
-                ax.set_ylim(*panel.y_range)
-            if panel.x_range is not None:
-                ax.set_xlim(*panel.x_range)
-            if panel.equal_aspect:
-                ax.set_aspect("equal")
-            ax.set_title(panel.title, fontsize=10)
-            ax.set_ylabel(panel.y_label)
-            ax.set_xlabel(panel.x_label or x_label)
-            ax.grid(alpha=0.3, which="both" if panel.y_log else "major")
-            if any(g.legend for g in panel.glyphs):
-                ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
+        fig, drawn, axes = draw_panels(self.panels, data, x_label)
+        lines: dict[str, list] = {}  # seules les courbes qui dépendent des curseurs sont redessinées
+        for column, found in drawn.items():
+            moving = [line for line in found if column in self.series or line.kc_columns[0] in self.series]
+            if moving:
+                lines[column] = moving
+        self._fills = list(fig.kc_fills)
         return fig, lines, axes
-
-    @staticmethod
-    def _fill(ax, glyph, data, label=None):
-        lower = np.zeros_like(data[glyph.column]) if glyph.kind == "area" else data[glyph.column]
-        upper = data[glyph.column] if glyph.kind == "area" else data[glyph.upper]
-        return ax.fill_between(data[glyph.x], lower, upper, color=glyph.color, alpha=0.25 * glyph.alpha,
-                               lw=0, label=label)
 
     def _text(self) -> str:
         return "" if self.readout is None else str(self.readout(self.series, self.values()))
@@ -300,7 +255,7 @@ class LiveExplorer:
         fills = []
         for ax, glyph, collection in self._fills:
             collection.remove()
-            fills.append((ax, glyph, self._fill(ax, glyph, data)))
+            fills.append((ax, glyph, fill_glyph(ax, glyph, data)))
         self._fills = fills
         for ax, panel in zip(self._axes, self.panels):
             if panel.y_range is None:
@@ -318,5 +273,5 @@ class LiveExplorer:
         return self.widget._repr_mimebundle_(**kwargs)
 
     def __repr__(self) -> str:
-        values = ", ".join(f"{k} = {v:.3g}" for k, v in self.values().items())
+        values = " ; ".join(f"{k} = {format_spec(v, '.3g')}" for k, v in self.values().items())
         return f"<Curseurs vivants ({values}) : exige un noyau Jupyter en marche>"

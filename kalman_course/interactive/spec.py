@@ -137,3 +137,88 @@ def check_columns(panels, known: set[str], lengths: Mapping[str, int] | None = N
                     raise KalmanInputError(
                         f"Le tracé « {glyph.legend} » mêle des séries de longueurs différentes ({detail})."
                     )
+
+
+#: Styles de trait et marqueurs matplotlib des tracés décrits par :class:`Glyph`.
+MPL_DASH = {"solid": "-", "dashed": "--", "dotted": ":", "dashdot": "-."}
+MPL_MARKER = {"cross": "+", "circle": "o", "square": "s", "diamond": "D", "triangle": "^", "x": "x",
+              "star": "*", "dot": "."}
+
+
+def fill_glyph(ax, glyph: Glyph, data, label=None):
+    """Une surface (``"area"`` : entre 0 et la série ; ``"band"`` : entre deux séries) ; renvoie la
+    collection matplotlib (à retirer et redessiner quand les séries changent)."""
+    import numpy as np
+
+    lower = np.zeros_like(data[glyph.column]) if glyph.kind == "area" else data[glyph.column]
+    upper = data[glyph.column] if glyph.kind == "area" else data[glyph.upper]
+    return ax.fill_between(data[glyph.x], lower, upper, color=glyph.color, alpha=0.25 * glyph.alpha, lw=0,
+                           label=label)
+
+
+def draw_panels(panels, data, x_label: str, *, height_px_per_inch: float = 80.0):
+    """Dessine les panneaux avec matplotlib (sans pyplot), un sous-graphique par panneau.
+
+    Sert aux curseurs vivants (:mod:`.live`, figure redessinée à chaque mouvement) et à l'image fixe
+    des curseurs statiques (:mod:`.static`, figure du PDF à la position par défaut des curseurs).
+
+    Paramètres
+    ----------
+    panels : suite de Panel
+    data : dict nom → (L,)
+        Toutes les séries lues par les tracés, dont ``"t"`` (le temps commun).
+    x_label : str
+        Libellé de l'abscisse commune, avec unité.
+
+    Renvoie ``(fig, lines, axes)`` : la figure, ``lines`` (dict nom de série → liste de ``Line2D``
+    tracées ; chaque ligne porte ``kc_columns = (abscisse, ordonnée)``), les axes (un par panneau). Les
+    surfaces (``"area"``, ``"band"``) sont dans ``fig.kc_fills``, liste de ``(axe, tracé, collection)``.
+    """
+    from ..figures import new_figure
+    from ..numbers import french_figure
+
+    panels = tuple(panels)
+    height = sum(p.height for p in panels) / height_px_per_inch
+    shared = not any(p.own_x for p in panels)
+    fig, axes = new_figure(len(panels), 1, width=7.0, height=height, sharex=shared, squeeze=False)
+    axes = axes[:, 0]
+    lines: dict[str, list] = {}
+    fills: list = []
+    for ax, panel in zip(axes, panels):
+        for glyph in panel.glyphs:
+            x = glyph.x
+            label = glyph.legend or None
+            if glyph.kind in ("hline", "vline"):
+                draw = ax.axhline if glyph.kind == "hline" else ax.axvline
+                draw(glyph.value, color=glyph.color, lw=1.5, ls=MPL_DASH[glyph.dash], label=label)
+                continue
+            if glyph.kind in ("area", "band"):
+                fills.append((ax, glyph, fill_glyph(ax, glyph, data, label)))
+                continue
+            if glyph.kind == "scatter":
+                style = {"marker": MPL_MARKER[glyph.marker], "ls": "none", "ms": glyph.size * 0.9}
+            else:
+                style = {"lw": glyph.width * 0.9, "ls": MPL_DASH[glyph.dash]}
+            (line,) = ax.plot(data[x], data[glyph.column], color=glyph.color, label=label, alpha=glyph.alpha,
+                              **style)
+            line.kc_columns = (x, glyph.column)  # séries (abscisse, ordonnée) à relire au redessin
+            lines.setdefault(glyph.column, []).append(line)
+        if panel.y_log:
+            ax.set_yscale("log")
+        if panel.x_log:
+            ax.set_xscale("log")
+        if panel.y_range is not None:
+            ax.set_ylim(*panel.y_range)
+        if panel.x_range is not None:
+            ax.set_xlim(*panel.x_range)
+        if panel.equal_aspect:
+            ax.set_aspect("equal")
+        ax.set_title(panel.title, fontsize=10)
+        ax.set_ylabel(panel.y_label)
+        ax.set_xlabel(panel.x_label or x_label)
+        ax.grid(alpha=0.3, which="both" if panel.y_log else "major")
+        if any(g.legend for g in panel.glyphs):
+            ax.legend(loc="upper right" if panel.y_log else "lower right", fontsize=8)
+    french_figure(fig)  # graduations et nombres des légendes à la française
+    fig.kc_fills = fills
+    return fig, lines, axes

@@ -16,17 +16,27 @@
    boutons de lancement sont retirés, mais le téléchargement du carnet exécuté (``.ipynb``) reste
    proposé sur chaque chapitre. Colab n'ouvre que des ``.ipynb`` hébergés sur GitHub : sur une page
    dont la source est un ``.md`` MyST sans ``.ipynb`` jumeau, le bouton Colab est retiré.
+
+3. **Figures à curseurs dans le PDF.** Une figure à curseurs statiques fournit, à côté de son HTML,
+   une image PNG (position par défaut des curseurs) et une légende (attribut
+   :data:`~.static.CAPTION_ATTRIBUTE`). Pour le constructeur LaTeX, avant que myst-nb ne choisisse
+   l'image dans la sortie de la cellule, l'extension place cette sortie dans une figure légendée.
+   Une figure à curseurs sans image de repli est un avertissement (donc une erreur avec ``-W``).
 """
 
 from __future__ import annotations
 
+import html
+import re
 import shutil
 from pathlib import Path
 
+from docutils import nodes
 from sphinx.errors import ExtensionError
+from sphinx.transforms.post_transforms import SphinxPostTransform
 from sphinx.util import logging
 
-from .static import BOKEH_VERSION, MARKER, bokehjs_files
+from .static import BOKEH_VERSION, CAPTION_ATTRIBUTE, MARKER, bokehjs_files
 
 __all__ = ["setup", "installed_bokehjs", "JUPYTER_BOOK_DEFAULT_REPOSITORY"]
 
@@ -131,6 +141,38 @@ def _drop_duplicate_inline_scripts(app, pagename, templatename, context, doctree
     context["script_files"] = kept
 
 
+class StaticSlidersForLatex(SphinxPostTransform):
+    """LaTeX : la sortie d'une figure à curseurs statiques devient une figure légendée dont l'image est
+    le PNG de repli. S'exécute avant le choix du type MIME par myst-nb (priorité 4)."""
+
+    default_priority = 3
+    builders = ("latex",)
+
+    def run(self, **kwargs) -> None:
+        for bundle in list(self.document.findall(nodes.container)):
+            if bundle.get("nb_element") != "mime_bundle":
+                continue
+            by_type = {child.get("mime_type"): child for child in bundle.children}
+            html_part = by_type.get("text/html")
+            if html_part is None or MARKER not in html_part.astext():
+                continue
+            if "image/png" not in by_type:
+                LOGGER.warning(
+                    "[kalman_course] figure à curseurs statiques sans image PNG de repli : elle manquerait "
+                    "au PDF (relancer l'exécution du carnet).",
+                    location=bundle,
+                )
+                continue
+            found = re.search(CAPTION_ATTRIBUTE + r'="([^"]*)"', html_part.astext())
+            caption = html.unescape(found.group(1)) if found else ""
+            figure = nodes.figure(classes=["kc-static-sliders"])
+            figure.source, figure.line = bundle.source, bundle.line
+            bundle.replace_self(figure)
+            figure += bundle
+            if caption:
+                figure += nodes.caption(caption, caption)
+
+
 def setup(app):
     app.add_config_value("kc_ipynb_download", False, "html", types=[bool])
     app.connect("config-inited", _guard_launch_buttons, priority=900)
@@ -141,4 +183,5 @@ def setup(app):
     app.connect("html-page-context", _ipynb_download, priority=500)
     app.connect("html-page-context", _drop_colab_for_markdown, priority=502)
     app.connect("html-page-context", _drop_duplicate_inline_scripts, priority=900)
+    app.add_post_transform(StaticSlidersForLatex)
     return {"version": BOKEH_VERSION, "parallel_read_safe": True, "parallel_write_safe": True}

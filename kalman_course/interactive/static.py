@@ -11,6 +11,11 @@ balises ``<script>`` dans l'en-tête des seules pages qui contiennent une telle 
 l'attribut :data:`MARKER`), une fois par page, avec un chemin relatif qui marche en ``http://`` comme
 en ``file://``. Hors du livre (dans Jupyter), la figure affiche un message qui renvoie vers les
 curseurs vivants (:mod:`kalman_course.interactive.live`).
+
+Le PDF du cours (constructeur LaTeX) ne peut pas animer de curseurs : la figure fournit aussi une
+image PNG (matplotlib, mêmes panneaux, exécution de la position par défaut des curseurs) et une
+légende (:meth:`StaticSliders.caption`, dans l'attribut HTML :data:`CAPTION_ATTRIBUTE`) ; l'extension
+Sphinx place l'image dans une figure légendée du PDF. Le site, lui, affiche toujours le HTML.
 """
 
 from __future__ import annotations
@@ -40,14 +45,18 @@ from bokeh.models import (
 from bokeh.plotting import figure
 
 from ..core.validation import KalmanInputError, as_float_array
+from ..book_typography import french_spacing
 from ..numbers import bokeh_tick_formatter
 from .grid import ParameterGrid
 from .spec import Panel, check_columns
 
-__all__ = ["MARKER", "BOKEH_VERSION", "PLOTTED_SOURCE", "bokehjs_files", "plotted_source_name", "StaticSliders"]
+__all__ = ["MARKER", "CAPTION_ATTRIBUTE", "BOKEH_VERSION", "PLOTTED_SOURCE", "bokehjs_files", "plotted_source_name",
+           "StaticSliders"]
 
 #: Attribut HTML qui signale une figure à curseurs statiques (lu par l'extension Sphinx).
 MARKER = "data-kc-bokeh"
+#: Attribut HTML qui porte la légende de la figure imprimée (PDF), lue par l'extension Sphinx.
+CAPTION_ATTRIBUTE = "data-kc-caption"
 #: Version de BokehJS attendue par les figures (celle du paquet Python ``bokeh`` installé).
 BOKEH_VERSION = bokeh.__version__
 
@@ -176,14 +185,15 @@ class StaticSliders:
     def _sliders(self) -> list[Slider]:
         sliders = []
         for k, axis in enumerate(self.grid.axes):
-            labels = axis.labels()
+            labels = [french_spacing(label) for label in axis.labels()]
             sliders.append(
                 Slider(
                     start=0,
                     end=axis.values.size - 1,
                     step=1,
                     value=axis.default,
-                    title=f"{axis.symbol} — {axis.description}",
+                    # Bokeh écrit « titre: valeur » : l'espace insécable finale donne « titre : valeur »
+                    title=french_spacing(f"{axis.symbol} — {axis.description}") + "\u00a0",
                     # le curseur se déplace sur les indices de la grille et affiche la vraie valeur
                     format=CustomJSTickFormatter(args={"labels": labels}, code="return labels[Math.round(tick)];"),
                     sizing_mode="stretch_width",
@@ -269,7 +279,7 @@ class StaticSliders:
                 if panel.width is not None:
                     size = {"width": panel.width, "height": int(round(panel.width / ratio)), "sizing_mode": "fixed"}
             fig = figure(
-                title=panel.title,
+                title=french_spacing(panel.title),
                 tools="pan,box_zoom,wheel_zoom,reset,save",
                 toolbar_location="right",
                 x_range=Range1d(*panel.x_range) if panel.own_x else time_range,
@@ -280,8 +290,8 @@ class StaticSliders:
             )
             fig.toolbar.logo = None  # pas de lien sortant vers bokeh.org
             fig.toolbar.autohide = True
-            fig.xaxis.axis_label = panel.x_label or self.x_label
-            fig.yaxis.axis_label = panel.y_label
+            fig.xaxis.axis_label = french_spacing(panel.x_label or self.x_label)
+            fig.yaxis.axis_label = french_spacing(panel.y_label)
             # graduations en français (virgule décimale, × 10ⁿ), sur les axes linéaires et logarithmiques
             fig.xaxis.formatter = bokeh_tick_formatter()
             fig.yaxis.formatter = bokeh_tick_formatter()
@@ -289,7 +299,7 @@ class StaticSliders:
             for glyph in panel.glyphs:
                 r = self._glyph(fig, panel, glyph, source_of)
                 if glyph.legend:
-                    items.append(LegendItem(label=glyph.legend, renderers=[r]))
+                    items.append(LegendItem(label=french_spacing(glyph.legend), renderers=[r]))
             # légende au-dessus du tracé : elle ne cache jamais les courbes
             if items:
                 fig.add_layout(
@@ -303,7 +313,8 @@ class StaticSliders:
         readout = None
         texts: list[str] = []
         if self.readout is not None:
-            texts = [str(self.readout(index)) for index in itertools.product(*(range(n) for n in grid.shape))]
+            texts = [french_spacing(str(self.readout(index)))
+                     for index in itertools.product(*(range(n) for n in grid.shape))]
             readout = Div(text=texts[int(np.ravel_multi_index(grid.default_index, grid.shape))],
                           name="kc-readout", css_classes=["kc-readout"], render_as_text=True,
                           sizing_mode="stretch_width")
@@ -322,7 +333,7 @@ class StaticSliders:
         )
         for slider in sliders:
             slider.js_on_change("value", callback)
-        header = [Div(text=f"<strong>{html.escape(self.title)}</strong>")] if self.title else []
+        header = [Div(text=f"<strong>{html.escape(french_spacing(self.title))}</strong>")] if self.title else []
         controls = [row(*sliders, sizing_mode="stretch_width")] + ([readout] if readout is not None else [])
         return column(*header, *controls, *figures, sizing_mode="stretch_width")
 
@@ -349,6 +360,35 @@ class StaticSliders:
         return fig.varea(x=glyph.x, y1=glyph.column, y2=glyph.upper, source=source, fill_color=glyph.color,
                          fill_alpha=0.25 * glyph.alpha)
 
+    # ------------------------------------------------------------------ image fixe (PDF)
+
+    def default_figure(self):
+        """La figure matplotlib des mêmes panneaux, à la position par défaut des curseurs : les mêmes
+        séries que la figure Bokeh à son ouverture (exécution ``grid.default_index``)."""
+        from .spec import draw_panels
+
+        data = {"t": np.array(self.grid.time), **self.fixed, **self.grid.run(*self.grid.default_index)}
+        fig, _, _ = draw_panels(self.panels, data, self.x_label)
+        return fig
+
+    def caption(self) -> str:
+        """Légende de la figure imprimée : titre et valeurs des curseurs à leur position par défaut."""
+        values = ", ".join(
+            f"{axis.symbol} = {axis.labels()[axis.default]}" for axis in self.grid.axes
+        )
+        sizes = " × ".join(map(str, self.grid.shape))
+        title = self.title or f"Figure à curseurs « {self.name} »"
+        one = len(self.grid.axes) == 1
+        return french_spacing(
+            f"{title}. {'Curseur à sa' if one else 'Curseurs à leur'} position par défaut ({values}) ; dans le "
+            f"livre en ligne, {'il parcourt' if one else 'ils parcourent'} les {sizes} exécutions précalculées."
+        )
+
+    def _repr_mimebundle_(self, include=None, exclude=None):
+        """HTML (figure Bokeh, pour le site) et PNG de repli (position par défaut, pour le PDF)."""
+        png, size = self.default_figure()._repr_png_()
+        return {"text/html": self.html(), "image/png": png}, {"image/png": size}
+
     # ------------------------------------------------------------------ sortie HTML
 
     def html(self) -> str:
@@ -369,7 +409,8 @@ class StaticSliders:
             f"Dans Jupyter, utilisez les curseurs vivants{hint}."
         )
         return (
-            f'<div class="kc-bokeh-figure" {MARKER}="{self.name}" data-bokeh-version="{BOKEH_VERSION}">\n'
+            f'<div class="kc-bokeh-figure" {MARKER}="{self.name}" data-bokeh-version="{BOKEH_VERSION}" '
+            f'{CAPTION_ATTRIBUTE}="{html.escape(self.caption(), quote=True)}">\n'
             f'<div id="{root_id}" class="kc-bokeh-root"><p class="kc-bokeh-missing">{missing}</p></div>\n'
             f'<script type="application/json" id="{root_id}-item">{item}</script>\n'
             "<script>(function () {\n"

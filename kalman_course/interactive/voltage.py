@@ -13,6 +13,7 @@ import numpy as np
 from ..filters.kalman import kalman_filter
 from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
 from ..core.validation import KalmanInputError, as_float_array
+from ..numbers import format_spec
 from .figure import SliderSpec, register_sliders
 from .grid import ParameterAxis, ParameterGrid, log_grid, precompute_grid
 from .spec import Glyph, Panel
@@ -88,14 +89,14 @@ def voltage_grid(n_steps: int = 50, P0: float = VOLTAGE_P0, per_decade: int = 2)
 def voltage_panels() -> tuple[Panel, ...]:
     r"""La figure du chapitre, décrite une fois pour les deux sortes de curseurs : estimation,
     :math:`P_n` (échelle log), :math:`K_n`."""
-    truth = f"valeur vraie x = {TRUE_VOLTAGE} V"  # comme la figure statique du chapitre
+    truth = f"valeur vraie x = {format_spec(TRUE_VOLTAGE, 'g')} V"  # comme la figure statique du chapitre
     return (
         Panel(
             "Valeur vraie, mesures et estimation",
             "tension (V)",
             (
                 Glyph("", "hline", "green", truth, value=TRUE_VOLTAGE),
-                Glyph("z", "scatter", "firebrick", "mesures zₙ"),
+                Glyph("z", "scatter", "firebrick", "mesures yₙ"),
                 Glyph("x", "line", "royalblue", "estimation x̂ₙ"),
             ),
             height=260,

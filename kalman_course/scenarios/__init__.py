@@ -10,12 +10,24 @@ from .voltage import (
 from . import engine, radar, tag  # noqa: F401  (moteur 2×2 ; suivi du tag UWB ; radar de l'EKF itéré)
 from . import camera_target  # noqa: F401  (pose d'une cible vue par une caméra, EKF itéré sur SE(3))
 from . import diffuse  # noqa: F401  (départ sans a priori : SRIF contre filtre de Kalman)
+from . import nile, smoothing  # noqa: F401  (le Nil et le niveau local ; la cible du lissage)
+from . import pendulum  # noqa: F401  (pendule : UKF, filtre particulaire)
+from . import banana, distant_target  # noqa: F401  (UKF : la « banane » polaire, la cible lointaine)
+from . import growth, convergence, importance  # noqa: F401  (filtre particulaire, EnKF : bimodal, convergence, poids)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
 __all__ = [
+    "banana",
+    "convergence",
+    "distant_target",
+    "growth",
+    "importance",
     "diffuse",
+    "nile",
+    "smoothing",
     "engine",
+    "pendulum",
     "position_rmse",
     "radar",
     "radar_iterations",

@@ -1,16 +1,15 @@
-r"""Une loi gaussienne en coordonnées polaires transformée en coordonnées cartésiennes (chapitres « Le
-filtre de Kalman étendu » et « Pour aller plus loin »).
+r"""Une loi gaussienne en coordonnées polaires transformée en coordonnées cartésiennes (chapitre « Le
+filtre de Kalman étendu »).
 
 :math:`x = (r, \theta) \sim \mathcal N(\hat x, P)`, :math:`\hat x = (10\ \text{m}, 0)`,
 :math:`P = \operatorname{diag}(\sigma_r^2, \sigma_\theta^2)`, transformée par
-:math:`f(r, \theta) = (r\cos\theta, r\sin\theta)`. Trois approximations de la loi de :math:`f(x)` :
+:math:`f(r, \theta) = (r\cos\theta, r\sin\theta)`. Deux approximations de la loi de :math:`f(x)` :
 
 - **exacte** (Monte-Carlo) : moyenne et covariance empiriques de 3000 tirages (graine fixe ; les mêmes
   tirages normaux sont mis à l'échelle de :math:`(\sigma_r, \sigma_\theta)`) ;
-- **EKF** : :math:`f(\hat x)` et :math:`J P J^T` (:func:`~kalman_course.ekf_predict`, bruit d'état nul) ;
-- **UKF** : transformée « unscented » de filterpy (points sigma de van der Merwe, les réglages de
-  :func:`~kalman_course.filterpy_unscented_filter` : :math:`\alpha = 0{,}1`, :math:`\beta = 2`,
-  :math:`\kappa = 3 - n`).
+- **EKF** : :math:`f(\hat x)` et :math:`J P J^T` (:func:`~kalman_course.ekf_predict`, bruit d'état nul).
+
+(La transformée sans parfum de la même loi est au chapitre de l'UKF, :mod:`.banana`.)
 
 Avec :math:`\sigma_r = 0{,}5` m et :math:`\sigma_\theta = 20°`, c'est la figure de linéarisation du
 chapitre de l'EKF.
@@ -33,8 +32,6 @@ __all__ = [
     "POLAR_BEARING_STD_DEG",
     "POLAR_SAMPLES",
     "POLAR_SEED",
-    "UT_ALPHA",
-    "UT_BETA",
     "polar_to_cartesian",
     "polar_to_cartesian_jacobian",
     "PolarTransform",
@@ -50,8 +47,6 @@ POLAR_BEARING_STD_DEG = 20.0
 #: Nombre de tirages et graine du Monte-Carlo (ceux de la figure du chapitre).
 POLAR_SAMPLES = 3000
 POLAR_SEED = 11
-#: Réglages des points sigma (ceux de l'UKF de filterpy du paquet).
-UT_ALPHA, UT_BETA = 0.1, 2.0
 
 
 def polar_to_cartesian(x, u=None):
@@ -68,8 +63,7 @@ def polar_to_cartesian_jacobian(x, u=None):
 @dataclass(frozen=True, eq=False)
 class PolarTransform:
     r"""``samples`` (N, 2) tirages polaires (m, rad) ; ``mapped`` (N, 2) leurs images (m) ;
-    ``exact_mean`` (2,), ``exact_cov`` (2, 2) : moments empiriques des images ; ``ekf_mean``, ``ekf_cov`` ;
-    ``ukf_mean``, ``ukf_cov`` ; ``sigma_points`` (5, 2) et leurs images ``sigma_mapped`` (5, 2)."""
+    ``exact_mean`` (2,), ``exact_cov`` (2, 2) : moments empiriques des images ; ``ekf_mean``, ``ekf_cov``."""
 
     samples: np.ndarray
     mapped: np.ndarray
@@ -77,24 +71,14 @@ class PolarTransform:
     exact_cov: np.ndarray
     ekf_mean: np.ndarray
     ekf_cov: np.ndarray
-    ukf_mean: np.ndarray
-    ukf_cov: np.ndarray
-    sigma_points: np.ndarray
-    sigma_mapped: np.ndarray
 
     def __post_init__(self) -> None:
-        freeze_fields(self, "samples", "mapped", "exact_mean", "exact_cov", "ekf_mean", "ekf_cov", "ukf_mean",
-                      "ukf_cov", "sigma_points", "sigma_mapped")
+        freeze_fields(self, "samples", "mapped", "exact_mean", "exact_cov", "ekf_mean", "ekf_cov")
 
     @property
     def ekf_bias(self) -> float:
         """Distance (m) entre la moyenne de l'EKF et la moyenne exacte."""
         return float(np.linalg.norm(self.ekf_mean - self.exact_mean))
-
-    @property
-    def ukf_bias(self) -> float:
-        """Distance (m) entre la moyenne de l'UKF et la moyenne exacte."""
-        return float(np.linalg.norm(self.ukf_mean - self.exact_mean))
 
 
 def _std(name: str, value) -> float:
@@ -106,10 +90,8 @@ def _std(name: str, value) -> float:
 
 def polar_transform(range_std: float = POLAR_RANGE_STD, bearing_std_deg: float = POLAR_BEARING_STD_DEG,
                     n_samples: int = POLAR_SAMPLES, seed: int = POLAR_SEED) -> PolarTransform:
-    r"""Les trois approximations de la loi de :math:`f(x)` pour :math:`\sigma_r` = ``range_std`` (m) et
+    r"""Les deux approximations de la loi de :math:`f(x)` pour :math:`\sigma_r` = ``range_std`` (m) et
     :math:`\sigma_\theta` = ``bearing_std_deg`` (degrés)."""
-    from filterpy.kalman import MerweScaledSigmaPoints, unscented_transform
-
     std = np.array([_std("range_std", range_std), np.deg2rad(_std("bearing_std_deg", bearing_std_deg))])
     P = np.diag(std**2)
     model = NonlinearModel(polar_to_cartesian, lambda x: x[:1], np.zeros((2, 2)), np.eye(1),
@@ -118,9 +100,4 @@ def polar_transform(range_std: float = POLAR_RANGE_STD, bearing_std_deg: float =
     rng = np.random.default_rng(seed)
     samples = POLAR_MEAN + rng.standard_normal((n_samples, 2)) * std
     mapped = np.array([polar_to_cartesian(s) for s in samples])
-    points = MerweScaledSigmaPoints(2, alpha=UT_ALPHA, beta=UT_BETA, kappa=3.0 - 2)
-    sigmas = points.sigma_points(np.array(POLAR_MEAN), P)
-    sigma_mapped = np.array([polar_to_cartesian(s) for s in sigmas])
-    ukf_mean, ukf_cov = unscented_transform(sigma_mapped, points.Wm, points.Wc)
-    return PolarTransform(samples, mapped, mapped.mean(axis=0), np.cov(mapped.T), pred.x, pred.P,
-                          ukf_mean, ukf_cov, sigmas, sigma_mapped)
+    return PolarTransform(samples, mapped, mapped.mean(axis=0), np.cov(mapped.T), pred.x, pred.P)

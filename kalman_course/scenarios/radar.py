@@ -65,8 +65,11 @@ RADAR_SEED = 3
 
 
 def range_bearing(x: np.ndarray) -> np.ndarray:
-    r"""Distance et azimut de la position :math:`(x_0, x_1)` vus de l'origine : :math:`[\,\lVert p\rVert,\ \operatorname{atan2}(p_y, p_x)\,]` (m, rad)."""
-    return np.array([np.hypot(x[0], x[1]), np.arctan2(x[1], x[0])])
+    r"""Distance et azimut de la position :math:`(x_0, x_1)` vus de l'origine : :math:`[\,\lVert p\rVert,\ \operatorname{atan2}(p_y, p_x)\,]` (m, rad).
+
+    Forme (2,) pour un état, (N, 2) pour une pile d'états (N, n) (modèle vectorisé)."""
+    x = np.asarray(x)
+    return np.stack([np.hypot(x[..., 0], x[..., 1]), np.arctan2(x[..., 1], x[..., 0])], axis=-1)
 
 
 def range_bearing_jacobian(x: np.ndarray, n_state: int = 2) -> np.ndarray:
@@ -83,7 +86,7 @@ def range_bearing_jacobian(x: np.ndarray, n_state: int = 2) -> np.ndarray:
 
 def radar_model(range_std: float = RADAR_RANGE_STD, bearing_std: float = RADAR_BEARING_STD) -> NonlinearModel:
     r"""Modèle de la correction unique : état = position (2,), :math:`h` = distance et azimut (angle en
-    composante 1). La dynamique (identité, bruit nul) ne sert pas."""
+    composante 1). La dynamique (identité, bruit nul) ne sert pas. Modèle vectorisé."""
     return NonlinearModel(
         f=lambda x, u: x,
         h=range_bearing,
@@ -92,6 +95,7 @@ def radar_model(range_std: float = RADAR_RANGE_STD, bearing_std: float = RADAR_B
         f_jacobian=np.eye(2),
         h_jacobian=range_bearing_jacobian,
         angle_indices=(1,),
+        vectorized=True,
     )
 
 
@@ -220,16 +224,18 @@ def radar_tracking_model(
     range_std: float = RADAR_RANGE_STD,
     bearing_std: float = RADAR_BEARING_STD,
 ) -> NonlinearModel:
-    r"""Cible à vitesse constante (état :math:`[p_x, p_y, v_x, v_y]`) vue par le radar (distance, azimut)."""
+    r"""Cible à vitesse constante (état :math:`[p_x, p_y, v_x, v_y]`) vue par le radar (distance, azimut) ;
+    modèle vectorisé (``f`` et ``h`` acceptent une pile d'états (N, 4))."""
     F = cv_transition(dt)
     return NonlinearModel(
-        f=lambda x, u: F @ x,
+        f=lambda x, u: x.dot(F.T),  # un état (4,) ou une pile (N, 4)
         h=range_bearing,
         Q=cv_process_noise(dt, accel_std),
         R=np.diag([range_std**2, bearing_std**2]),
         f_jacobian=F,
         h_jacobian=lambda x: range_bearing_jacobian(x, 4),
         angle_indices=(1,),
+        vectorized=True,
     )
 
 

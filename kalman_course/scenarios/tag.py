@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..filters.extended import extended_kalman_filter
+from ..filters.unscented import unscented_kalman_filter
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, freeze_fields
 from ..core.simulation import as_generator
@@ -41,6 +42,9 @@ __all__ = [
     "TAG_X0",
     "TAG_P0",
     "TAG_TRANSIENT_STEPS",
+    "TAG_UKF_ALPHA",
+    "TAG_UKF_BETA",
+    "TAG_UKF_KAPPA",
     "TagData",
     "tag_trajectory",
     "tag_ranges",
@@ -79,11 +83,17 @@ TAG_P0 = np.diag([9.0, 9.0, 1.0, 1.0])
 TAG_P0.setflags(write=False)
 #: Pas ignorés par :func:`position_rmse` (régime transitoire, 2 s).
 TAG_TRANSIENT_STEPS = 20
+#: Points sigma de l'UKF du tag : :math:`\alpha = 0{,}1`, :math:`\beta = 2`, :math:`\kappa = 3 - n` (n = 4).
+TAG_UKF_ALPHA = 0.1
+TAG_UKF_BETA = 2.0
+TAG_UKF_KAPPA = -1.0
 
 
 def tag_ranges(x: np.ndarray, anchors: np.ndarray = TAG_ANCHORS) -> np.ndarray:
-    r"""Distances du tag aux ancres :math:`h(x)_i = \lVert p - a_i\rVert` (m), forme (n_ancres,)."""
-    return np.linalg.norm(x[:2] - anchors, axis=1)
+    r"""Distances du tag aux ancres :math:`h(x)_i = \lVert p - a_i\rVert` (m) : forme (n_ancres,) pour un
+    état (4,), (N, n_ancres) pour une pile d'états (N, 4) (modèle vectorisé)."""
+    x = np.asarray(x)
+    return np.linalg.norm(x[..., None, :2] - anchors, axis=-1)
 
 
 def tag_ranges_jacobian(x: np.ndarray, anchors: np.ndarray = TAG_ANCHORS) -> np.ndarray:
@@ -104,6 +114,7 @@ def tag_model(
 
     :math:`f(x) = Fx` (jacobienne :math:`F` constante), :math:`Q = \sigma_a^2GG^T`,
     :math:`h` = :func:`tag_ranges` (jacobienne :func:`tag_ranges_jacobian`), :math:`R = \sigma_r^2 I`.
+    Modèle vectorisé : ``f`` et ``h`` acceptent aussi une pile d'états (N, 4).
     ``accel_std`` (m/s²) et ``range_std`` (m) sont les réglages du filtre (pas forcément ceux des données).
     """
     for name, value in (("accel_std", accel_std), ("range_std", range_std), ("dt", dt)):
@@ -114,12 +125,13 @@ def tag_model(
         raise KalmanInputError(f"« anchors » doit être de forme (N, 2) ; reçu {shape_text(A.shape)}.")
     F = cv_transition(dt)
     return NonlinearModel(
-        f=lambda x, u: F @ x,
+        f=lambda x, u: x.dot(F.T),  # un état (4,) ou une pile (N, 4)
         h=lambda x: tag_ranges(x, A),
         Q=cv_process_noise(dt, accel_std),
         R=range_std**2 * np.eye(A.shape[0]),
         f_jacobian=F,
         h_jacobian=lambda x: tag_ranges_jacobian(x, A),
+        vectorized=True,
     )
 
 
@@ -188,14 +200,20 @@ def run_tag_ekf(
 
 
 def run_tag_ukf(
-    accel_std: float = TAG_ACCEL_STD, range_std: float = TAG_RANGE_STD, data: TagData | None = None
+    accel_std: float = TAG_ACCEL_STD,
+    range_std: float = TAG_RANGE_STD,
+    data: TagData | None = None,
+    *,
+    alpha: float = TAG_UKF_ALPHA,
+    beta: float = TAG_UKF_BETA,
+    kappa: float = TAG_UKF_KAPPA,
 ) -> FilterResult:
-    """Même problème avec le filtre de Kalman « unscented » de filterpy (voir :mod:`kalman_course.ukf_reference`)."""
-    from ..filters.filterpy_unscented import filterpy_unscented_filter
-
+    r"""Même problème avec le filtre de Kalman sans parfum du paquet
+    (:func:`~kalman_course.unscented_kalman_filter`), points sigma :math:`(\alpha, \beta, \kappa)`
+    (par défaut :math:`0{,}1`, 2 et :math:`3 - n = -1`)."""
     data = tag_data() if data is None else data
     model = tag_model(accel_std, range_std, data.dt, data.anchors)
-    return filterpy_unscented_filter(model, data.y, data.x0, data.P0)
+    return unscented_kalman_filter(model, data.y, data.x0, data.P0, alpha=alpha, beta=beta, kappa=kappa)
 
 
 def position_rmse(x_est: Any, x_true: Any, skip: int = TAG_TRANSIENT_STEPS) -> float:
@@ -230,6 +248,8 @@ def rmse_grid(accel_stds: Any, range_stds: Any, data: TagData | None = None) -> 
 def rmse_table(accel_stds: Any, range_stds: Any, data: TagData | None = None) -> Table:
     r""":func:`rmse_grid` en tableau (centimètres) : une ligne par :math:`\sigma_a`, une colonne par :math:`\sigma_r`."""
     grid = 100 * rmse_grid(accel_stds, range_stds, data)
-    headers = [r"$\sigma_a$ (m/s²) ↓ · $\sigma_r$ (m) →"] + [f"{r:g}" for r in range_stds]
-    columns = [[f"{q:g}" for q in accel_stds]] + [grid[:, j] for j in range(grid.shape[1])]
+    from ..numbers import format_spec  # Babel, chargé à l'affichage seulement
+
+    headers = [r"$\sigma_a$ (m/s²) ↓ · $\sigma_r$ (m) →"] + [format_spec(r, "g") for r in range_stds]
+    columns = [[format_spec(q, "g") for q in accel_stds]] + [grid[:, j] for j in range(grid.shape[1])]
     return Table(headers, columns, [None] + ["{:.1f}"] * grid.shape[1])

@@ -1,0 +1,179 @@
+r"""Filtre de Kalman d'ensemble stochastique (EnKF : Evensen 1994 ; observations perturbées : Burgers,
+van Leeuwen & Evensen 1998) : étapes pures et famille pour le moteur.
+
+La loi est représentée par :math:`N` membres :math:`x^i` ; la moyenne et la covariance ne sont que des
+statistiques d'échantillon, :math:`\bar x = \frac1N\sum_i x^i`,
+:math:`P = \frac1{N-1}\sum_i (x^i - \bar x)(x^i - \bar x)^T` — un centre météorologique ne forme jamais
+:math:`P` (:math:`n \approx 10^8`) : il n'en utilise que les produits par :math:`H^T`.
+
+* prévision : :math:`x^i \leftarrow f(x^i, u) + w^i`, :math:`w^i \sim \mathcal N(0, Q)` ;
+* analyse : avec :math:`\bar y = \frac1N\sum_i h(x^i)`,
+
+  .. math::
+
+      P_{xy} = \tfrac1{N-1}\sum_i (x^i - \bar x)(h(x^i) - \bar y)^T,\quad
+      P_{yy} = \tfrac1{N-1}\sum_i (h(x^i) - \bar y)(h(x^i) - \bar y)^T,\quad
+      K = P_{xy}(P_{yy} + R)^{-1},
+
+      x^i \leftarrow x^i + K\,(y + v^i - h(x^i)),\qquad v^i \sim \mathcal N(0, R).
+
+Sans les perturbations :math:`v^i`, la dispersion de l'ensemble analysé serait
+:math:`(I - KH)P(I - KH)^T` au lieu de :math:`(I - KH)P` : trop petite. Sur un modèle linéaire gaussien,
+la moyenne et la covariance de l'ensemble tendent vers celles du filtre de Kalman quand :math:`N \to \infty`
+(erreur en :math:`1/\sqrt N`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+import scipy.linalg
+
+from ..core.angles import wrap_angle
+from ..core.linalg import covariance_factor, symmetrize
+from ..core.models import NonlinearModel
+from ..core.results import FilterResult
+from ..core.simulation import check_positive_int
+from ..core.validation import KalmanInputError, as_gaussian
+from .engine import Correction, FilterFamily, run_filter
+from .extended import NONLINEAR_HINT
+
+__all__ = ["EnsembleFilterResult", "ensemble_family", "ensemble_kalman_filter"]
+
+_posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class EnsembleFilterResult(FilterResult):
+    r"""Résultat de l'EnKF : les champs de :class:`~kalman_course.FilterResult` (``x`` moyenne et ``P``
+    covariance d'échantillon de l'ensemble, ``K`` gain de l'analyse…) et ``members`` (T, N, n), l'ensemble
+    analysé de chaque pas si ``keep_members=True`` (sinon ``None``)."""
+
+    members: np.ndarray | None = None
+
+
+class EnsembleState(NamedTuple):
+    """État interne : ``X`` (N, n) les membres ; ``k`` l'indice de la mesure visée (messages d'erreur)."""
+
+    X: np.ndarray
+    k: int
+
+
+def _moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    x = X.mean(axis=0)
+    D = X - x
+    return x, symmetrize(D.T.dot(D) / (X.shape[0] - 1))
+
+
+def _angles(model: NonlinearModel, idx) -> list[int]:
+    if not model.angle_indices:
+        return []
+    if idx is None:
+        return list(model.angle_indices)
+    return [j for j, i in enumerate(idx) if int(i) in model.angle_indices]
+
+
+def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = True) -> FilterFamily:
+    r"""Les étapes de l'EnKF stochastique pour le moteur (famille ``stochastic``) ; ``perturb=False``
+    retire les perturbations :math:`v^i` des observations (pour montrer pourquoi elles sont nécessaires)."""
+    N = check_positive_int("n_members", n_members, minimum=2)
+    if not isinstance(perturb, (bool, np.bool_)):
+        raise KalmanInputError(f"« perturb » doit être un booléen ; reçu {perturb!r}.")
+
+    def prior(model, x0, P0, rng):
+        if model.f_noise_jacobian is not None or model.h_noise_jacobian is not None:
+            raise KalmanInputError(
+                "L'EnKF du paquet suppose des bruits additifs : le modèle ne doit avoir ni f_noise_jacobian ni "
+                "h_noise_jacobian."
+            )
+        x, P = as_gaussian(x0, P0, model.n_state, "x0", "P0")
+        return EnsembleState(x + rng.standard_normal((N, model.n_state)).dot(covariance_factor(P).T), -1)
+
+    def predict_step(model, state, u, rng):
+        X = model.transition_many(state.X, u)
+        X = X + rng.standard_normal(X.shape).dot(covariance_factor(model.Q).T)
+        return EnsembleState(X, state.k + 1)
+
+    def update_step(model, state, y, idx, rng):
+        X = state.X
+        HX = model.observe_many(X)
+        R = model.R
+        if idx is not None:
+            HX, R = HX[:, idx], R[np.ix_(idx, idx)]
+        angles = _angles(model, idx)
+        x_bar = X.mean(axis=0)
+        y_bar = HX.mean(axis=0)
+        if angles:
+            y_bar[angles] = np.arctan2(np.sin(HX[:, angles]).mean(axis=0), np.cos(HX[:, angles]).mean(axis=0))
+        dX = X - x_bar
+        dY = HX - y_bar
+        if angles:
+            dY[:, angles] = wrap_angle(dY[:, angles])
+        Pxy = dX.T.dot(dY) / (N - 1)
+        S = dY.T.dot(dY) / (N - 1) + R
+        _, Kt, info = _posv(S, Pxy.T)
+        if info != 0:
+            raise KalmanInputError(
+                f"EnKF, analyse par y[{state.k}] : la covariance d'innovation P_yy + R n'est pas définie positive."
+            )
+        K = Kt.T
+        D = y - HX
+        if perturb:
+            D = D + rng.standard_normal((N, R.shape[0])).dot(np.linalg.cholesky(R).T)
+        if angles:
+            D[:, angles] = wrap_angle(D[:, angles])
+        X_new = X + D.dot(K.T)
+        nu = model.residual(y, y_bar, idx)
+        return EnsembleState(X_new, state.k), Correction(K, nu, S)
+
+    def outputs(state):
+        return {"members": state.X} if keep_members else {}
+
+    return FilterFamily(
+        name="filtre de Kalman d'ensemble (EnKF)",
+        model_type=NonlinearModel,
+        model_hint=NONLINEAR_HINT,
+        prior=prior,
+        predict=predict_step,
+        update=update_step,
+        moments=lambda state: _moments(state.X),
+        result_type=EnsembleFilterResult,
+        stochastic=True,
+        step_outputs=outputs if keep_members else None,
+    )
+
+
+def ensemble_kalman_filter(
+    model: NonlinearModel,
+    y: Any,
+    x0: Any,
+    P0: Any,
+    u: Any = None,
+    *,
+    n_members: int,
+    rng: Any,
+    keep_members: bool = False,
+    perturb: bool = True,
+) -> EnsembleFilterResult:
+    r"""Filtre de Kalman d'ensemble stochastique (observations perturbées) sur toutes les mesures.
+
+    Paramètres
+    ----------
+    model : NonlinearModel à bruits additifs (``vectorized=True`` conseillé : tout l'ensemble passe par
+        ``f`` et ``h`` en un appel).
+    y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante (ligne entière : prévision seule).
+    x0 : (n,), P0 : (n, n) — loi de l'ensemble initial.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    n_members : taille :math:`N \ge 2` de l'ensemble.
+    rng : graine entière ou ``numpy.random.Generator`` (obligatoire).
+    keep_members : garder l'ensemble analysé de chaque pas (``members`` (T, N, n)).
+    perturb : perturber les observations (défaut, l'EnKF stochastique) ; ``False`` : même gain sans
+        perturbations — l'ensemble analysé est alors trop resserré, :math:`(I-KH)P(I-KH)^T` au lieu de
+        :math:`(I-KH)P` (démonstration du chapitre).
+
+    Renvoie un :class:`EnsembleFilterResult` : ``x`` (T, n) moyenne, ``P`` (T, n, n) covariance
+    d'échantillon, ``K`` (T, n, m) gain de l'analyse, ``innovation`` :math:`y - \bar y`, ``S`` :math:`P_{yy} + R`.
+    """
+    return run_filter(ensemble_family(n_members, keep_members, perturb), model, y, x0, P0, u, rng=rng)

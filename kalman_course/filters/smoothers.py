@@ -1,0 +1,489 @@
+r"""Lisseurs : le lisseur de Rauch–Tung–Striebel (1965) et sa version étendue.
+
+Le filtre donne :math:`\hat x_{k\mid k}`, ce qu'on sait de l'état **au pas** :math:`k` ; le lisseur
+donne :math:`\hat x_{k\mid T}`, ce qu'on en sait **à la fin**, toutes les mesures reçues. Une passe
+arrière, de :math:`k = T-1` à :math:`1`, sur les résultats du filtre :
+
+.. math::
+
+    G_k = P_{k\mid k}A^T P_{k+1\mid k}^{-1},\qquad
+    \hat x_{k\mid T} = \hat x_{k\mid k} + G_k\,(\hat x_{k+1\mid T} - \hat x_{k+1\mid k}),
+
+    P_{k\mid T} = P_{k\mid k} + G_k\,(P_{k+1\mid T} - P_{k+1\mid k})\,G_k^T,\qquad
+    P_{k+1,k\mid T} = \operatorname{Cov}(x_{k+1}, x_k \mid y_{1:T}) = P_{k+1\mid T}G_k^T,
+
+en partant de :math:`\hat x_{T\mid T}`, :math:`P_{T\mid T}` (la dernière estimation du filtre). La
+covariance de décalage un :math:`P_{k+1,k\mid T}` sert à l'algorithme EM
+(:func:`~kalman_course.likelihood.expectation_maximization`). :math:`G_k` vient d'une résolution
+linéaire, jamais d'une inverse. Un pas sans mesure a :math:`\hat x_{k\mid k} = \hat x_{k\mid k-1}` et
+ne demande rien de particulier ; la commande est déjà dans les prédictions
+:math:`\hat x_{k+1\mid k}` du filtre.
+
+* :func:`rts_smoother` lisse un résultat de :func:`~kalman_course.kalman_filter` (:math:`A`) ou de
+  :func:`~kalman_course.filters.diffuse.diffuse_kalman_filter` (départ diffus exact) ;
+* :func:`extended_rts_smoother` lisse un résultat de l'EKF (ou de l'EKF itéré) : :math:`A` devient la
+  jacobienne :math:`F_k = \partial f/\partial x` en :math:`(\hat x_{k\mid k}, u)`, la prédiction du filtre ;
+* :func:`unscented_rts_smoother` lisse un résultat de l'UKF (Särkkä, 2008) : la covariance croisée
+  :math:`C_{k,k+1}` des points sigma remplace :math:`P_{k\mid k}F_k^T`.
+
+Les deux vérifient que le résultat vient bien du filtre de ce modèle (prédictions
+:math:`P_{k+1\mid k} = F_kP_{k\mid k}F_k^T + Q` et :math:`S_k = CP_{k\mid k-1}C^T + R` retrouvées) :
+un résultat d'un autre modèle ou d'un autre filtre est refusé. Le résultat :class:`SmootherResult`
+est commun à tous les lisseurs (un lisseur RTS « unscented » pourra le remplir : ses gains
+:math:`G_k = C_{k,k+1}P_{k+1\mid k}^{-1}` ont la même forme).
+
+Ce module n'importe pas matplotlib.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+
+from ..core.linalg import symmetrize
+from ..core.models import LinearGaussianModel, NonlinearModel
+from ..core.results import FilterResult, FilterRuns, freeze
+from ..core.validation import KalmanInputError, as_controls, as_gaussian, check_instance
+from .diffuse import DiffuseFilterResult, is_determined
+from .extended import NONLINEAR_HINT
+
+__all__ = ["SmootherResult", "rts_smoother", "extended_rts_smoother", "unscented_rts_smoother", "smoother_gains",
+           "rts_pass", "CONSISTENCY_RTOL"]
+
+#: Tolérance relative de la vérification « ce résultat vient du filtre de ce modèle ».
+CONSISTENCY_RTOL = 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class SmootherResult:
+    r"""Sortie d'un lisseur sur ``T`` pas (``n`` états), sur l'axe des temps du filtre.
+
+    Attributs
+    ---------
+    x : (T, n)
+        Estimation lissée :math:`\hat x_{k\mid T}`.
+    P : (T, n, n)
+        Covariance lissée :math:`P_{k\mid T}`.
+    G : (T, n, n)
+        Gains du lisseur : ``G[k]`` relie les lignes ``k`` et ``k+1`` ; ``G[T-1] = 0`` (dernier pas :
+        le lissage ne change rien). NaN aux pas dont l'estimation filtrée n'est pas déterminée (départ
+        diffus).
+    P_lag : (T, n, n)
+        Covariances de décalage un :math:`\operatorname{Cov}(x_k, x_{k-1}\mid y_{1:T})` : ``P_lag[k]``
+        relie la ligne ``k`` à la précédente ; ``P_lag[0]`` la relie à l'état initial (instant 0) quand
+        celui-ci est lissé (``x0``, ``P0`` donnés), NaN sinon.
+    x_initial : (n,) ou None
+        État initial lissé :math:`\hat x_{0\mid T}` (si l'a priori ``x0``, ``P0`` du filtre est donné).
+    P_initial : (n, n) ou None
+        Sa covariance :math:`P_{0\mid T}`.
+    G_initial : (n, n) ou None
+        Le gain qui relie l'état initial à la ligne 0.
+    method : str
+        Le lisseur (« RTS », « RTS étendu », « RTS, départ diffus exact »…).
+    """
+
+    x: np.ndarray
+    P: np.ndarray
+    G: np.ndarray
+    P_lag: np.ndarray
+    x_initial: np.ndarray | None = None
+    P_initial: np.ndarray | None = None
+    G_initial: np.ndarray | None = None
+    method: str = "RTS"
+
+    def __post_init__(self) -> None:
+        for name in ("x", "P", "G", "P_lag", "x_initial", "P_initial", "G_initial"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, freeze(getattr(self, name)))
+
+    @property
+    def n_steps(self) -> int:
+        """Nombre de pas ``T``."""
+        return self.x.shape[0]
+
+    def std(self) -> np.ndarray:
+        r"""Écarts-types lissés :math:`\sqrt{\operatorname{diag} P_{k\mid T}}`, forme (T, n)."""
+        return np.sqrt(np.diagonal(self.P, axis1=-2, axis2=-1))
+
+    def __repr__(self) -> str:
+        return f"<SmootherResult ({self.method}) : {self.n_steps} pas, état de dimension {self.x.shape[1]}>"
+
+
+# --------------------------------------------------------------------------- noyau
+
+
+def smoother_gains(P: np.ndarray, P_pred_next: np.ndarray, F: np.ndarray) -> np.ndarray:
+    r"""Gains :math:`G_k = P_kF_k^T(P^-_{k+1})^{-1}` pour une pile de pas, par résolution de
+    :math:`P^-_{k+1}G_k^T = F_kP_k` (:math:`P_k` et :math:`P^-_{k+1}` symétriques).
+
+    ``P`` (N, n, n), ``P_pred_next`` (N, n, n), ``F`` (N, n, n) ou (n, n). Si :math:`P^-_{k+1}` est
+    singulière (bruit d'état dégénéré), la solution de moindres carrés (pseudo-inverse) est la bonne :
+    :math:`F_kP_kF_k^T \preceq P^-_{k+1}`, donc l'image de :math:`F_kP_k` est dans celle de
+    :math:`P^-_{k+1}`."""
+    rhs = F @ P
+    try:
+        Gt = np.linalg.solve(P_pred_next, rhs)
+        if not np.isfinite(Gt).all():
+            raise np.linalg.LinAlgError
+    except np.linalg.LinAlgError:
+        Gt = np.empty_like(rhs)
+        for k in range(rhs.shape[0]):
+            Gt[k] = scipy.linalg.lstsq(P_pred_next[k], rhs[k])[0]
+    return np.swapaxes(Gt, -1, -2)
+
+
+def rts_pass(x: np.ndarray, P: np.ndarray, x_pred: np.ndarray, P_pred: np.ndarray, G: np.ndarray):
+    r"""Passe arrière de RTS avec des gains ``G`` (T, n, n) déjà calculés (``G[T-1]`` ignoré).
+
+    ``x`` (T, n) — ou (T, n, c) : plusieurs moyennes filtrées ensemble, comme le filtre augmenté du
+    départ diffus — ``P`` (T, n, n), ``x_pred``, ``P_pred`` du filtre. Renvoie ``(xs, Ps, P_lag)`` ;
+    ``P_lag[k]`` :math:`= P_{k\mid T}G_{k-1}^T` pour :math:`k \ge 1`, NaN en 0."""
+    T = x.shape[0]
+    xs = np.empty_like(x)
+    Ps = np.empty_like(P)
+    xs[-1], Ps[-1] = x[-1], P[-1]
+    x_next, P_next = xs[-1], Ps[-1]
+    for k in range(T - 2, -1, -1):
+        Gk = G[k]
+        x_next = x[k] + Gk.dot(x_next - x_pred[k + 1])
+        Pk = P[k] + Gk.dot(P_next - P_pred[k + 1]).dot(Gk.T)
+        P_next = 0.5 * (Pk + Pk.T)  # symétrisation (arrondis)
+        xs[k], Ps[k] = x_next, P_next
+    lag = np.full_like(P, np.nan)
+    lag[1:] = Ps[1:] @ np.swapaxes(G[:-1], 1, 2)  # Cov(x_{k+1}, x_k | y) = P_{k+1|T} G_kᵀ
+    return xs, Ps, lag
+
+
+# --------------------------------------------------------------------------- vérifications
+
+
+def _check_result(result: Any) -> FilterResult:
+    if isinstance(result, FilterRuns):
+        raise KalmanInputError(
+            "« result » est un lot de tirages (FilterRuns) : lissez un tirage à la fois, par exemple "
+            "rts_smoother(model, runs.run(0))."
+        )
+    check_instance("result", result, FilterResult, "la sortie d'un filtre, par exemple kalman_filter")
+    if result.x.ndim != 2:
+        raise KalmanInputError(
+            f"« result » a des états de forme {result.x.shape[1:]} : le lisseur RTS attend des vecteurs "
+            "(T, n) (les poses SE(3) ne sont pas prises en charge)."
+        )
+    return result
+
+
+def _close(a: np.ndarray, b: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """Écart relatif maximal par pas entre ``a`` et ``b`` (…, ·) rapporté à ``scale`` (…,)."""
+    axes = tuple(range(1, a.ndim))
+    return np.max(np.abs(a - b), axis=axes) / np.maximum(scale, np.finfo(float).tiny)
+
+
+def _mismatch(where: str, what: str, k: int, err: float, filters: str) -> KalmanInputError:
+    return KalmanInputError(
+        f"« result » ne vient pas du {filters} de ce modèle : {what} au pas k = {k} ne correspond pas "
+        f"(écart relatif {err:.2g}). Lissez le résultat du filtre qui a utilisé ce même « model »{where}."
+    )
+
+
+def _check_consistency(result: FilterResult, P_pred_next: np.ndarray, x_pred_next: np.ndarray | None,
+                       H: np.ndarray, Rn: np.ndarray, filters: str, where: str) -> None:
+    r"""Le résultat doit être celui du filtre de ce modèle : :math:`P^-_{k+1}` (et :math:`\hat x^-_{k+1}`
+    si fourni) recalculés depuis la ligne ``k``, :math:`S_k = HP^-_kH^T + R` sur les composantes
+    observées (si ``H`` est donnée). ``P_pred_next`` (T-1, n, n), ``x_pred_next`` (T-1, n) ou
+    (T-1, n, c), ``H`` (T, m, n), (m, n) ou None, ``Rn`` (T, m, m) ou (m, m)."""
+    if result.n_steps > 1:
+        ref = result.P_pred[1:]
+        err = _close(P_pred_next, ref, np.max(np.abs(ref), axis=(1, 2)))
+        if (err > CONSISTENCY_RTOL).any():
+            k = int(np.argmax(err > CONSISTENCY_RTOL))
+            raise _mismatch(where, "la covariance prédite P_pred[k+1] = F P[k] Fᵀ + Q", k, float(err[k]), filters)
+        if x_pred_next is not None:
+            refx = result.x_pred[1:]
+            sd = np.sqrt(np.max(np.diagonal(ref, axis1=1, axis2=2), axis=1))
+            scale = np.max(np.abs(refx), axis=tuple(range(1, refx.ndim))) + sd
+            err = _close(x_pred_next, refx, scale)
+            if (err > CONSISTENCY_RTOL).any():
+                k = int(np.argmax(err > CONSISTENCY_RTOL))
+                raise _mismatch(where, "la prédiction x_pred[k+1] = f(x[k], u)", k, float(err[k]), filters)
+    obs = np.asarray(result.observed, dtype=bool)
+    rows = obs.any(axis=1)
+    if H is not None and rows.any():
+        Hs = np.broadcast_to(H, (result.n_steps,) + np.shape(H)[-2:])[rows]
+        Rs = np.broadcast_to(Rn, (result.n_steps,) + np.shape(Rn)[-2:])[rows]
+        S = Hs @ result.P_pred[rows] @ np.swapaxes(Hs, 1, 2) + Rs
+        both = obs[rows][:, :, None] & obs[rows][:, None, :]
+        S_ref = np.where(both, result.S[rows], 0.0)
+        S_new = np.where(both, S, 0.0)
+        err = _close(S_new, S_ref, np.max(np.abs(S_ref), axis=(1, 2)))
+        if (err > CONSISTENCY_RTOL).any():
+            k = int(np.flatnonzero(rows)[np.argmax(err > CONSISTENCY_RTOL)])
+            i = int(np.argmax(err > CONSISTENCY_RTOL))
+            raise _mismatch(where, "la covariance d'innovation S[k] = C P_pred[k] Cᵀ + R", k, float(err[i]), filters)
+
+
+def _check_finite(result: FilterResult) -> None:
+    bad = ~np.isfinite(result.P).all(axis=(1, 2)) | ~np.isfinite(result.x).all(axis=1)
+    if bad.any():
+        raise KalmanInputError(
+            f"« result » contient des estimations non déterminées (NaN) à partir du pas k = {int(np.argmax(bad))} : "
+            "pour un départ sans a priori, filtrez avec diffuse_kalman_filter, dont rts_smoother sait lisser "
+            "le résultat."
+        )
+
+
+def _initial(model_n: int, x0: Any, P0: Any):
+    if (x0 is None) != (P0 is None):
+        raise KalmanInputError("« x0 » et « P0 » vont ensemble : donnez les deux (a priori du filtre) ou aucun.")
+    if x0 is None:
+        return None
+    return as_gaussian(x0, P0, model_n, "x0", "P0")
+
+
+def _smooth_initial(x0, P0, F0, Q0, fx0, result: FilterResult, xs0, Ps0):
+    """Lisse l'état initial (instant 0) : vérifie que ``(x0, P0)`` est l'a priori du filtre."""
+    P_pred0 = symmetrize(F0.dot(P0).dot(F0.T) + Q0)
+    ref = result.P_pred[0]
+    if np.max(np.abs(P_pred0 - ref)) > CONSISTENCY_RTOL * max(np.max(np.abs(ref)), np.finfo(float).tiny):
+        raise KalmanInputError(
+            "« P0 » n'est pas l'a priori du filtre : F P0 Fᵀ + Q ne redonne pas result.P_pred[0]. "
+            "Donnez les x0, P0 passés au filtre."
+        )
+    if fx0 is not None:
+        scale = np.max(np.abs(result.x_pred[0])) + np.sqrt(np.max(np.diag(ref)))
+        if np.max(np.abs(fx0 - result.x_pred[0])) > CONSISTENCY_RTOL * max(scale, np.finfo(float).tiny):
+            raise KalmanInputError(
+                "« x0 » n'est pas l'a priori du filtre : sa prédiction ne redonne pas result.x_pred[0]. "
+                "Donnez les x0, P0 passés au filtre."
+            )
+    G0 = smoother_gains(P0[None], ref[None], F0)[0]
+    x_init = x0 + G0.dot(xs0 - result.x_pred[0])
+    P_init = symmetrize(P0 + G0.dot(Ps0 - ref).dot(G0.T))
+    return x_init, P_init, G0, Ps0.dot(G0.T)
+
+
+# --------------------------------------------------------------------------- lisseurs
+
+
+def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = None, P0: Any = None) -> SmootherResult:
+    r"""Lisseur de Rauch–Tung–Striebel pour un résultat du filtre de Kalman linéaire.
+
+    .. math::
+
+        G_k = P_{k\mid k}A^TP_{k+1\mid k}^{-1},\quad
+        \hat x_{k\mid T} = \hat x_{k\mid k} + G_k(\hat x_{k+1\mid T} - \hat x_{k+1\mid k}),\quad
+        P_{k\mid T} = P_{k\mid k} + G_k(P_{k+1\mid T} - P_{k+1\mid k})G_k^T.
+
+    Paramètres
+    ----------
+    model : LinearGaussianModel — celui du filtre.
+    result : FilterResult de :func:`~kalman_course.kalman_filter` (mesures manquantes et commandes
+        comprises), ou :class:`~kalman_course.filters.diffuse.DiffuseFilterResult` de
+        :func:`~kalman_course.diffuse_kalman_filter` (départ diffus exact, voir plus bas).
+    x0 : (n,), P0 : (n, n), optionnels — l'a priori donné au filtre : l'état initial (instant 0) est
+        alors lissé aussi (``x_initial``, ``P_initial``, ``G_initial``, ``P_lag[0]``).
+
+    Départ diffus : sachant :math:`\delta` (l'état de la première mesure), le filtre augmenté est un
+    filtre ordinaire ; on lisse ses moyennes :math:`[a \mid X]` (affines en :math:`\delta`) et sa
+    covariance, puis on intègre :math:`\delta \sim \mathcal N(J_T^{-1}h_T, J_T^{-1})` :
+    :math:`\hat x_{k\mid T} = a^s_k + X^s_kJ_T^{-1}h_T`,
+    :math:`P_{k\mid T} = P^{a,s}_k + X^s_kJ_T^{-1}X^{sT}_k` et
+    :math:`\operatorname{Cov}(x_{k+1}, x_k\mid y) = P^{a,s}_{k+1}G^{aT}_k + X^s_{k+1}J_T^{-1}X^{sT}_k`.
+
+    Renvoie un :class:`SmootherResult` (``x`` (T, n), ``P`` (T, n, n), ``G``, ``P_lag``).
+    """
+    check_instance("model", model, LinearGaussianModel, "pour un modèle non linéaire, utilisez extended_rts_smoother")
+    result = _check_result(result)
+    n, m = model.n_state, model.n_obs
+    if isinstance(result, DiffuseFilterResult):
+        if x0 is not None or P0 is not None:
+            raise KalmanInputError(
+                "« x0 », « P0 » : un résultat de diffuse_kalman_filter n'a pas d'a priori ; ne les donnez pas."
+            )
+        return _diffuse_rts(model, result)
+    _check_dimensions(result, n, m)
+    _check_finite(result)
+    A = model.A
+    x, P = result.x, result.P
+    x_next = (x[:-1] @ A.T) if model.B is None else None
+    _check_consistency(result, symmetrize(A @ P[:-1] @ A.T + model.Q), x_next, model.C, model.R,
+                       "filtre de Kalman", " (rts_smoother lisse la sortie de kalman_filter)")
+    G = np.zeros_like(P)
+    if result.n_steps > 1:
+        G[:-1] = smoother_gains(P[:-1], result.P_pred[1:], A)
+    xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
+    prior = _initial(n, x0, P0)
+    initial = (None, None, None)
+    if prior is not None:
+        x0_arr, P0_arr = prior
+        *initial, lag[0] = _smooth_initial(x0_arr, P0_arr, A, model.Q, A.dot(x0_arr) if model.B is None else None,
+                                           result, xs[0], Ps[0])
+    return SmootherResult(xs, Ps, G, lag, *initial, method="RTS")
+
+
+def _check_dimensions(result: FilterResult, n: int, m: int) -> None:
+    if result.x.shape[1] != n or result.innovation.shape[1] != m:
+        raise KalmanInputError(
+            f"« result » ne vient pas de ce modèle : états de dimension {result.x.shape[1]} et mesures de "
+            f"dimension {result.innovation.shape[1]}, le modèle attend n = {n} et m = {m}."
+        )
+
+
+def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> SmootherResult:
+    aug = result.augmented
+    n = model.n_state
+    _check_dimensions(result, n, model.n_obs)
+    A = model.A
+    x_next = np.einsum("ij,tjc->tic", A, aug.x[:-1]) if model.B is None else None
+    _check_consistency(aug, symmetrize(A @ aug.P[:-1] @ A.T + model.Q), x_next, model.C, model.R,
+                       "filtre de Kalman à départ diffus", " (diffuse_kalman_filter)")
+    J, h = result.information[-1], result.information_vector[-1]
+    if not is_determined(J):
+        raise KalmanInputError(
+            "Les mesures ne déterminent pas l'état (information J_T singulière : modèle non observable "
+            "ou trop peu de mesures) : pas de lissage possible sans a priori."
+        )
+    G_a = np.zeros_like(aug.P)
+    if result.n_steps > 1:
+        G_a[:-1] = smoother_gains(aug.P[:-1], aug.P_pred[1:], A)
+    xs_a, Ps_a, lag_a = rts_pass(aug.x, aug.P, aug.x_pred, aug.P_pred, G_a)
+    Xs = xs_a[:, :, 1:]
+    cho = scipy.linalg.cho_factor(J, lower=True)
+    delta = scipy.linalg.cho_solve(cho, h)
+    JiXt = np.stack([scipy.linalg.cho_solve(cho, Xk.T) for Xk in Xs])  # J⁻¹Xₖᵀ, (T, n, n)
+    xs = xs_a[:, :, 0] + Xs @ delta
+    Ps = symmetrize(Ps_a + Xs @ JiXt)
+    lag = np.full_like(Ps, np.nan)
+    lag[1:] = lag_a[1:] + Xs[1:] @ JiXt[:-1]
+    # gains du filtre exact là où son estimation est déterminée
+    G = np.full_like(Ps, np.nan)
+    G[-1] = 0.0
+    ok = np.isfinite(result.P[:-1]).all(axis=(1, 2))
+    if ok.any():
+        G[:-1][ok] = smoother_gains(result.P[:-1][ok], result.P_pred[1:][ok], A)
+    return SmootherResult(xs, Ps, G, lag, method="RTS, départ diffus exact")
+
+
+def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any = None, P0: Any = None,
+                          u: Any = None) -> SmootherResult:
+    r"""Lisseur RTS étendu pour un résultat de :func:`~kalman_course.extended_kalman_filter` (ou de l'EKF
+    itéré, dont la prédiction est la même).
+
+    :math:`A` devient la jacobienne de la prédiction du filtre,
+    :math:`F_k = \partial f/\partial x\,(\hat x_{k\mid k}, u_{k+1})` (la ligne ``k+1`` est prédite avec
+    ``u[k+1]``) :
+
+    .. math::
+
+        G_k = P_{k\mid k}F_k^TP_{k+1\mid k}^{-1},\quad
+        \hat x_{k\mid T} = \hat x_{k\mid k} + G_k(\hat x_{k+1\mid T} - \hat x_{k+1\mid k}),\quad
+        P_{k\mid T} = P_{k\mid k} + G_k(P_{k+1\mid T} - P_{k+1\mid k})G_k^T.
+
+    Sur un modèle linéaire (:meth:`~kalman_course.NonlinearModel.from_linear`), c'est :func:`rts_smoother`.
+
+    Paramètres
+    ----------
+    model : NonlinearModel — celui du filtre.
+    result : FilterResult de l'EKF.
+    x0 : (n,), P0 : (n, n), optionnels — l'a priori du filtre, pour lisser aussi l'état initial.
+    u : (T, p), ou (T,) si p = 1, optionnel — les commandes données au filtre (nécessaires : elles
+        entrent dans :math:`F_k`).
+    """
+    model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
+    result = _check_result(result)
+    if isinstance(result, DiffuseFilterResult):
+        raise KalmanInputError("« result » vient du filtre à départ diffus (linéaire) : lissez-le avec rts_smoother.")
+    n, m, T = model.n_state, model.n_obs, result.n_steps
+    _check_dimensions(result, n, m)
+    _check_finite(result)
+    U = as_controls("u", u, T, model.n_control)
+
+    def control(k):
+        return None if U is None else U[k]
+
+    x, P = result.x, result.P
+    F = np.empty((max(T - 1, 0), n, n))
+    Qn = np.empty_like(F)
+    fx = np.empty((max(T - 1, 0), n))
+    for k in range(T - 1):
+        F[k] = model.transition_jacobian(x[k], control(k + 1))
+        Qn[k] = model.process_noise(x[k], control(k + 1))
+        fx[k] = model.transition(x[k], control(k + 1))
+    # S_k = H P⁻ Hᵀ + VRVᵀ en x̂⁻ pour l'EKF ; l'EKF itéré linéarise ailleurs (dernier itéré) : seule sa
+    # prédiction, la même que celle de l'EKF, est alors vérifiée
+    H = Rn = None
+    iterated = result.n_iter is not None and bool((np.asarray(result.n_iter) > 1).any())
+    if not iterated:
+        H = np.empty((T, m, n))
+        Rn = np.empty((T, m, m))
+        for k in range(T):
+            H[k] = model.observation_jacobian(result.x_pred[k])
+            Rn[k] = model.measurement_noise(result.x_pred[k])
+    _check_consistency(result, symmetrize(F @ P[:-1] @ np.swapaxes(F, 1, 2) + Qn), fx, H, Rn,
+                       "filtre de Kalman étendu", " et les mêmes commandes « u » (extended_rts_smoother lisse la "
+                       "sortie d'extended_kalman_filter)")
+    G = np.zeros_like(P)
+    if T > 1:
+        G[:-1] = smoother_gains(P[:-1], result.P_pred[1:], F)
+    xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
+    prior = _initial(n, x0, P0)
+    initial = (None, None, None)
+    if prior is not None:
+        x0_arr, P0_arr = prior
+        F0 = model.transition_jacobian(x0_arr, control(0))
+        *initial, lag[0] = _smooth_initial(x0_arr, P0_arr, F0, model.process_noise(x0_arr, control(0)),
+                                           model.transition(x0_arr, control(0)), result, xs[0], Ps[0])
+    return SmootherResult(xs, Ps, G, lag, *initial, method="RTS étendu")
+
+
+def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha: float, beta: float = 2.0,
+                           kappa: float = 0.0, u: Any = None) -> SmootherResult:
+    r"""Lisseur RTS « sans parfum » (Särkkä, 2008) pour un résultat de
+    :func:`~kalman_course.unscented_kalman_filter`, avec les mêmes paramètres :math:`(\alpha, \beta, \kappa)`.
+
+    Pour :math:`k = T-2, \dots, 0` : points sigma :math:`\chi_i` de :math:`(\hat x_{k\mid k}, P_{k\mid k})`,
+    images :math:`\chi_i^f = f(\chi_i, u_{k+1})`, puis
+
+    .. math::
+
+        \bar x = \sum_i W^m_i\chi_i^f,\quad
+        \bar P = \sum_i W^c_i(\chi_i^f - \bar x)(\chi_i^f - \bar x)^T + Q,\quad
+        C = \sum_i W^c_i(\chi_i - \hat x_{k\mid k})(\chi_i^f - \bar x)^T,
+
+        G_k = C\bar P^{-1},\quad
+        \hat x_{k\mid T} = \hat x_{k\mid k} + G_k(\hat x_{k+1\mid T} - \bar x),\quad
+        P_{k\mid T} = P_{k\mid k} + G_k(P_{k+1\mid T} - \bar P)G_k^T .
+
+    :math:`(\bar x, \bar P)` est la prédiction de l'UKF : on vérifie qu'elle redonne celle du résultat
+    (même modèle, même filtre, mêmes paramètres). Sur un modèle linéaire avec :math:`\alpha = 1`,
+    :math:`\beta = 2`, :math:`\kappa = 0`, c'est :func:`rts_smoother`. ``G`` (T, n, n), ``P_lag`` comme
+    :func:`rts_smoother`. Paramètres : ``u`` (T, p) : les commandes données au filtre.
+    """
+    from .unscented import _points, sigma_weights
+
+    model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
+    result = _check_result(result)
+    n, m, T = model.n_state, model.n_obs, result.n_steps
+    _check_dimensions(result, n, m)
+    _check_finite(result)
+    U = as_controls("u", u, T, model.n_control)
+    Wm, Wc, lam = sigma_weights(n, alpha=alpha, beta=beta, kappa=kappa)
+    x, P = result.x, result.P
+    xb = np.empty((max(T - 1, 0), n))
+    Pb = np.empty((max(T - 1, 0), n, n))
+    G = np.zeros_like(P)
+    for k in range(T - 1):
+        X = _points(x[k], P[k], n + lam, f"lissage du pas {k}", "filtrée P")
+        Xf = model.transition_many(X, None if U is None else U[k + 1])
+        xb[k] = Wm.dot(Xf)
+        D = Xf - xb[k]
+        Pb[k] = symmetrize(D.T.dot(Wc[:, None] * D) + model.Q)
+        C = (X - x[k]).T.dot(Wc[:, None] * D)
+        G[k] = np.linalg.solve(Pb[k], C.T).T  # G = C P̄⁻¹, P̄ symétrique
+    _check_consistency(result, Pb, xb, None, None, "filtre de Kalman sans parfum",
+                       ", les mêmes paramètres (alpha, beta, kappa) et les mêmes commandes « u » "
+                       "(unscented_rts_smoother lisse la sortie d'unscented_kalman_filter)")
+    xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
+    return SmootherResult(xs, Ps, G, lag, method="RTS sans parfum")

@@ -1,0 +1,116 @@
+"""Oracle indépendant des filtres : la loi a posteriori de **toute** la trajectoire, calculée d'un bloc.
+
+Les inconnues sont l'état de départ et tous les bruits d'état, θ = (z, w_…) ; chaque état est une fonction
+affine de θ, x_k = Φ_k θ + c_k, et chaque mesure observée y_k = C_o x_k + v_k. La loi de θ sachant les
+mesures est gaussienne, calculée sous forme d'information par des matrices pleines (taille n·T) : aucune
+récurrence, aucun filtre. Départ connu : z = x_init ~ N(x0, P0) (instant 0) ; départ diffus : z = x_0 (état
+de la première mesure) sans a priori (précision nulle).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+import scipy.stats
+
+
+def _design(model, T, u, diffuse):
+    """Φ (T, n, d) et c (T, n) tels que x_k = Φ_k θ + c_k."""
+    A, n = np.asarray(model.A), model.n_state
+    B = None if model.B is None else np.asarray(model.B)
+    n_w = T - 1 if diffuse else T  # bruits d'état inconnus
+    d = n + n * n_w
+    Phi = np.zeros((T, n, d))
+    c = np.zeros((T, n))
+    if diffuse:
+        Phi[0, :, :n] = np.eye(n)
+    else:
+        Phi[0, :, :n] = A
+        Phi[0, :, n:2 * n] = np.eye(n)
+        if B is not None:
+            c[0] = B @ u[0]
+    for k in range(1, T):
+        Phi[k] = A @ Phi[k - 1]
+        j = (k if not diffuse else k - 1)
+        Phi[k, :, n + n * j:n + n * (j + 1)] += np.eye(n)
+        c[k] = A @ c[k - 1] + (0.0 if B is None else B @ u[k])
+    return Phi, c
+
+
+def _observations(model, y, Phi, c):
+    """Matrices empilées des composantes observées : H (N, d), offset (N,), y_o (N,), R (N, N)."""
+    C, R = np.asarray(model.C), np.asarray(model.R)
+    rows, offs, ys, blocks = [], [], [], []
+    for k in range(y.shape[0]):
+        o = ~np.isnan(y[k])
+        if not o.any():
+            continue
+        rows.append(C[o] @ Phi[k])
+        offs.append(C[o] @ c[k])
+        ys.append(y[k, o])
+        blocks.append(R[np.ix_(o, o)])
+    return np.vstack(rows), np.concatenate(offs), np.concatenate(ys), scipy.linalg.block_diag(*blocks)
+
+
+def batch_posterior(model, y, u=None, x0=None, P0=None):
+    """Moyennes (T, n), covariances (T, n, n), covariances de décalage un Cov(x_k, x_{k-1}) (T, n, n) ;
+    au départ connu, aussi l'état initial lissé (moyenne, covariance) et Cov(x_0, x_init)."""
+    y = np.asarray(y, dtype=float).reshape(len(y), model.n_obs)
+    T, n = y.shape[0], model.n_state
+    diffuse = x0 is None
+    Phi, c = _design(model, T, u, diffuse)
+    d = Phi.shape[2]
+    Qi = np.linalg.inv(np.asarray(model.Q))
+    prec = np.zeros((d, d))
+    mean_prior = np.zeros(d)
+    if not diffuse:
+        prec[:n, :n] = np.linalg.inv(np.asarray(P0))
+        mean_prior[:n] = x0
+    for j in range((d - n) // n):
+        prec[n + n * j:n + n * (j + 1), n + n * j:n + n * (j + 1)] = Qi
+    H, off, yo, Rb = _observations(model, y, Phi, c)
+    Ri = np.linalg.inv(Rb)
+    Lam = prec + H.T @ Ri @ H
+    b = prec @ mean_prior + H.T @ Ri @ (yo - off)
+    cov = np.linalg.inv(Lam)
+    theta = cov @ b
+    xs = np.einsum("tnd,d->tn", Phi, theta) + c
+    Ps = np.einsum("tnd,de,tme->tnm", Phi, cov, Phi)
+    lag = np.full((T, n, n), np.nan)
+    lag[1:] = np.einsum("tnd,de,tme->tnm", Phi[1:], cov, Phi[:-1])
+    out = {"x": xs, "P": Ps, "P_lag": lag}
+    if not diffuse:
+        E = np.zeros((n, d))
+        E[:, :n] = np.eye(n)  # x_init = z
+        out["x_initial"] = E @ theta
+        out["P_initial"] = E @ cov @ E.T
+        out["lag0"] = Phi[0] @ cov @ E.T
+    return out
+
+
+def batch_log_likelihood(model, y, u=None, x0=None, P0=None):
+    """log p(y) par la loi jointe des mesures observées ; départ diffus : la limite exacte
+    −½[N log 2π + log|Σ| + log|ZᵀΣ⁻¹Z| + rᵀ(Σ⁻¹ − Σ⁻¹Z(ZᵀΣ⁻¹Z)⁻¹ZᵀΣ⁻¹)r] (y = Zδ + e, e ~ N(0, Σ))."""
+    y = np.asarray(y, dtype=float).reshape(len(y), model.n_obs)
+    T, n = y.shape[0], model.n_state
+    diffuse = x0 is None
+    Phi, c = _design(model, T, u, diffuse)
+    H, off, yo, Rb = _observations(model, y, Phi, c)
+    d = Phi.shape[2]
+    cov_prior = np.zeros((d, d))
+    mean_prior = np.zeros(d)
+    if not diffuse:
+        cov_prior[:n, :n] = P0
+        mean_prior[:n] = x0
+    for j in range((d - n) // n):
+        cov_prior[n + n * j:n + n * (j + 1), n + n * j:n + n * (j + 1)] = model.Q
+    Sigma = H @ cov_prior @ H.T + Rb
+    r = yo - off - H @ mean_prior
+    if not diffuse:
+        return float(scipy.stats.multivariate_normal(np.zeros(r.size), Sigma).logpdf(r))
+    Z = H[:, :n]
+    Si = np.linalg.inv(Sigma)
+    M = Z.T @ Si @ Z
+    proj = Si - Si @ Z @ np.linalg.inv(M) @ Z.T @ Si
+    N = r.size
+    return float(-0.5 * (N * np.log(2 * np.pi) + np.linalg.slogdet(Sigma)[1] + np.linalg.slogdet(M)[1] + r @ proj @ r))

@@ -1,0 +1,48 @@
+"""Typographie française du livre (kalman_course.book_typography) : règles sur des chaînes écrites à la
+main, et transformation d'un document docutils qui laisse intacts code, formules et HTML brut."""
+
+from __future__ import annotations
+
+from docutils import nodes
+from docutils.core import publish_doctree
+
+from kalman_course.book_typography import french_spacing, typeset
+
+NB, NN = "\u00a0", "\u202f"
+
+
+def test_french_spacing_rules():
+    assert french_spacing("Le gain : un compromis ; vraiment ? Oui !") == (
+        f"Le gain{NB}: un compromis{NN}; vraiment{NN}? Oui{NN}!"
+    )
+    assert french_spacing("la « recette de cuisine » du filtre") == f"la «{NB}recette de cuisine{NB}» du filtre"
+    assert french_spacing("«mot»") == f"«{NB}mot{NB}»"
+    assert french_spacing("95 % des cas") == f"95{NN}% des cas"
+    assert french_spacing("l'estimation d'aujourd'hui") == "l’estimation d’aujourd’hui"
+    # déjà correct : inchangé (idempotent)
+    once = french_spacing("Note : « a » ; b ?")
+    assert french_spacing(once) == once
+
+
+def test_french_spacing_leaves_times_urls_and_math():
+    assert french_spacing("à 10:30, voir https://example.org/a:b") == "à 10:30, voir https://example.org/a:b"
+    assert french_spacing("avec $x' : y$ : fin") == f"avec $x' : y${NB}: fin"
+
+
+def test_typeset_skips_code_math_and_raw():
+    doc = publish_doctree(
+        "Titre : test\n============\n\n"
+        "Texte : l'**estimation** ; voir ``code : 'a'`` et :math:`x' : y` !\n\n"
+        "::\n\n    print('a : b')\n\n"
+        ".. raw:: html\n\n   <b>brut : 'x'</b>\n",
+        settings_overrides={"report_level": 5},
+    )
+    typeset(doc)
+    text = doc.astext()
+    assert f"Titre{NB}: test" in text
+    assert f"Texte{NB}: l’estimation{NN}; voir" in text
+    assert "code : 'a'" in text  # littéral intact
+    assert "x' : y" in [n.astext() for n in doc.findall(nodes.math)]
+    assert "print('a : b')" in text
+    assert "<b>brut : 'x'</b>" in text
+    assert text.rstrip().endswith("brut : 'x'</b>")
