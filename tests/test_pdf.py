@@ -146,7 +146,7 @@ def test_static_slider_figures_are_printed_with_their_caption(pdf_build):
     assert sliders >= 1
     assert flat.count("Curseurs à leur position par défaut") == sliders
     assert pdf_build["tex"].count("Curseurs à leur position par défaut") == sliders
-    assert "Φ = 1·10⁻⁵ V², Ψ = 0,01 V²" in flat  # valeurs par défaut du chapitre « tension constante »
+    assert "Φ = 1 × 10⁻⁵ V², Ψ = 0,01 V²" in flat  # valeurs par défaut du chapitre « tension constante »
 
 
 def test_mermaid_diagrams_are_images(pdf_build):
