@@ -87,7 +87,7 @@ def format_number(
     ``decimals`` : nombre fixe de décimales ; ``significant`` : nombre de chiffres significatifs (3 par
     défaut si aucun des deux n'est donné). ``scientific`` : écriture :math:`m \times 10^{n}` ; par défaut
     (``None``), choisie avec ``significant`` quand :math:`|x| < 10^{-3}` ou :math:`|x| \ge 10^{6}`.
-    ``unit`` : unité ajoutée après une espace insécable (« 0,08 m »). ``trim`` : retire les zéros
+    ``unit`` : unité ajoutée après une espace insécable (« 0,08 m ») ; le degré d'angle est collé (« 20° »). ``trim`` : retire les zéros
     inutiles en fin de partie décimale (« 0,5 » plutôt que « 0,500 », comme le format ``g`` de Python).
     NaN s'écrit « NaN », l'infini « ∞ ».
 
@@ -122,7 +122,10 @@ def format_number(
             text = _power_of_ten(_fixed(mantissa, sig - 1, group=False, trim=trim), exponent)
         else:
             text = _fixed(rounded, max(sig - 1 - exponent, 0), trim=trim)
-    return text if unit is None else f"{text}\u00a0{unit}"
+    if unit is None:
+        return text
+    # le degré d'angle se colle au nombre (« 20° ») ; les autres unités, dont « °C », après une espace insécable
+    return f"{text}{unit}" if unit in ("°", "′", "″") else f"{text}\u00a0{unit}"
 
 
 def format_integer(value: Any) -> str:

@@ -42,6 +42,8 @@ M = "\u2212"  # signe moins
         (0.5, {"significant": 3, "trim": True}, "0,5"),
         (20000, {"decimals": 0}, f"20{NN}000"),
         (0.08, {"decimals": 2, "unit": "m"}, f"0,08{NB}m"),
+        (20.0, {"decimals": 0, "unit": "°"}, "20°"),  # le degré d'angle collé au nombre
+        (0.5, {"decimals": 1, "unit": "°C"}, f"0,5{NB}°C"),  # mais pas le degré Celsius
         (1.5e-5, {"decimals": 1, "scientific": True}, f"1,5{NN}×{NN}10⁻⁵"),
         (12.0, {"significant": 2, "scientific": True}, f"1,2{NN}×{NN}10¹"),
         (float("nan"), {}, "NaN"),

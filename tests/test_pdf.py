@@ -42,6 +42,15 @@ def _toc_docs() -> list[str]:
     return [toc["root"]] + [c["file"] for part in toc["parts"] for c in part["chapters"]]
 
 
+#: Appel d'une figure à curseurs dans un chapitre : ``kc.interactive.sliders("nom")`` ou ``…_sliders()``.
+_SLIDERS = re.compile(r'kc\.interactive\.(?:sliders\("[^"]+"\)|\w+_sliders\(\))')
+
+
+def _slider_figures() -> int:
+    """Nombre de figures à curseurs appelées par les chapitres du sommaire."""
+    return sum(len(_SLIDERS.findall((ROOT / f"{d}.md").read_text())) for d in _toc_docs())
+
+
 def _title(doc: str) -> str:
     return re.search(r"(?m)^# (.+)$", (ROOT / f"{doc}.md").read_text()).group(1).strip()
 
@@ -126,8 +135,7 @@ def test_math_of_every_chapter_is_typeset(pdf_build):
 
 def test_every_figure_is_an_image_that_is_not_empty(pdf_build, tmp_path):
     draws = sum(len(re.findall(r"kc\.figures\.draw\(", (ROOT / f"{d}.md").read_text())) for d in _toc_docs())
-    sliders = sum(len(re.findall(r"kc\.interactive\.\w+_sliders\(\)", (ROOT / f"{d}.md").read_text()))
-                  for d in _toc_docs())
+    sliders = _slider_figures()
     listing = subprocess.run(["pdfimages", "-list", str(pdf_build["pdf"])], check=True, capture_output=True,
                              text=True).stdout.splitlines()[2:]
     numbers = [int(line.split()[1]) for line in listing if line.split()[2] == "image"]  # pas les masques
@@ -141,11 +149,12 @@ def test_every_figure_is_an_image_that_is_not_empty(pdf_build, tmp_path):
 
 def test_static_slider_figures_are_printed_with_their_caption(pdf_build):
     flat = pdf_build["flat"]
-    sliders = sum(len(re.findall(r"kc\.interactive\.\w+_sliders\(\)", (ROOT / f"{d}.md").read_text()))
-                  for d in _toc_docs())
+    sliders = _slider_figures()
     assert sliders >= 1
-    assert flat.count("Curseurs à leur position par défaut") == sliders
-    assert pdf_build["tex"].count("Curseurs à leur position par défaut") == sliders
+    # « Curseurs à leur position par défaut » ; « Curseur à sa position… » quand la figure n'en a qu'un
+    caption = r"Curseurs? à (?:leur|sa) position par défaut"
+    assert len(re.findall(caption, flat)) == sliders
+    assert len(re.findall(caption, pdf_build["tex"])) == sliders
     assert "Φ = 1 × 10⁻⁵ V², Ψ = 0,01 V²" in flat  # valeurs par défaut du chapitre « tension constante »
 
 

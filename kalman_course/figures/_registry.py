@@ -16,6 +16,7 @@ __all__ = ["CHAPTER_TITLES", "CourseFigure", "FigureSpec", "REGISTRY", "register
 #: Titre de chaque chapitre (nom du fichier ``book/<nom>.md`` → titre de niveau 1), pour
 #: ``python -m kalman_course.figures --list`` ; ``tests/test_book.py`` vérifie qu'ils suivent le livre.
 CHAPTER_TITLES: dict[str, str] = {
+    "intuition": "Le filtre de Kalman en images",
     "controle-systeme": "Contrôle d'un système dynamique",
     "estimateur": "Construction d'un estimateur",
     "predicteur-correcteur": "Le filtre prédicteur–correcteur",

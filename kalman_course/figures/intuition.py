@@ -13,10 +13,7 @@ CHAPTER = "intuition"
 
 def _fr(value: float, unit: str) -> str:
     """Nombre français à trois chiffres significatifs, sans zéros finals (« 0,8 m² », « 12,4 m »)."""
-    text = format_number(value, significant=3)
-    if "," in text and "×" not in text:
-        text = text.rstrip("0").rstrip(",")
-    return f"{text}\u00a0{unit}" if unit else text
+    return format_number(value, significant=3, trim=True, unit=unit or None)
 
 
 @register("intuition-gaussiennes", chapter=CHAPTER,

@@ -108,6 +108,13 @@ def plotted_source_name(length: int, time_length: int) -> str:
     return PLOTTED_SOURCE if length == time_length else f"{PLOTTED_SOURCE}-{length}"
 
 
+def _setting(axis) -> str:
+    """« symbole = valeur » d'un axe à sa position par défaut ; l'étiquette qui porte déjà son symbole
+    (« n = 6 : correction ») est reprise telle quelle."""
+    label = axis.labels()[axis.default]
+    return label if label.startswith(f"{axis.symbol} =") else f"{axis.symbol} = {label}"
+
+
 @dataclass(eq=False)
 class StaticSliders:
     """Figure Bokeh à curseurs (un à trois) sur une grille précalculée (aucun noyau nécessaire).
@@ -373,9 +380,7 @@ class StaticSliders:
 
     def caption(self) -> str:
         """Légende de la figure imprimée : titre et valeurs des curseurs à leur position par défaut."""
-        values = ", ".join(
-            f"{axis.symbol} = {axis.labels()[axis.default]}" for axis in self.grid.axes
-        )
+        values = ", ".join(map(_setting, self.grid.axes))
         sizes = " × ".join(map(str, self.grid.shape))
         title = self.title or f"Figure à curseurs « {self.name} »"
         one = len(self.grid.axes) == 1
