@@ -9,12 +9,12 @@ filtres donnent les mêmes estimations.
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
 import kalman_course as kc
+from _timing import best_time
 
 TARGET = 0.8
 
@@ -30,16 +30,6 @@ def run_filterpy(model, y, x0, P0):
         f.predict()
         f.update(z)
     return f.x.ravel(), f.P
-
-
-def best_time(func, repeat):
-    best = np.inf
-    out = None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = func()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def bench(label, model, y, x0, P0, repeat):

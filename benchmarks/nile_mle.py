@@ -11,24 +11,15 @@ défaut, par gradients analytiques).
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 import statsmodels.api as sm
 
 import kalman_course as kc
 from kalman_course.scenarios.nile import local_level_from_log
+from _timing import best_time
 
 THETA0 = np.log([1e4, 1e3])
-
-
-def best_time(func, repeat):
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = func()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def main() -> None:

@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 import kalman_course as kc
 from kalman_course.scenarios import pendulum
+from _timing import best_time
 
 TARGET_RATIO = 3.0
 TARGET_SECONDS = 1.0
@@ -52,15 +52,6 @@ def plain_bootstrap(y, x0, P0, N, seed, dt=pendulum.PENDULUM_DT, g=pendulum.PEND
         D = X - m
         means[k], covs[k] = m, D.T @ (w[:, None] * D)
     return means, covs
-
-
-def best_time(func, repeat):
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = func()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def main() -> None:

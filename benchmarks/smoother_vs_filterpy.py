@@ -9,21 +9,12 @@ paquet vérifie en plus que le résultat vient bien du filtre de ce modèle (com
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
 import kalman_course as kc
-
-
-def best_time(func, repeat):
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = func()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+from _timing import best_time
 
 
 def bench(label, model, y, x0, P0, repeat):

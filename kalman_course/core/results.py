@@ -68,9 +68,9 @@ class FilterResult:
     n_iter: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        for f in fields(self):
+        for f in fields(self):  # ceux des sous-classes compris
             value = getattr(self, f.name)
-            if value is None:
+            if value is None or isinstance(value, FilterResult):  # un résultat emboîté est déjà figé
                 continue
             if f.name in ("observed", "n_iter"):
                 arr = np.array(value, copy=True)

@@ -43,7 +43,7 @@ Ce module n'importe pas matplotlib.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -142,19 +142,7 @@ class DiffuseFilterResult(FilterResult):
     n_diffuse: int = 0
 
     def __post_init__(self) -> None:
-        for f in fields(FilterResult):
-            value = getattr(self, f.name)
-            if value is None:
-                continue
-            if f.name in ("observed", "n_iter"):
-                arr = np.array(value, copy=True)
-                arr.setflags(write=False)
-            else:
-                arr = freeze(value)
-            object.__setattr__(self, f.name, arr)
-        for name in ("information", "information_vector"):
-            if getattr(self, name) is not None:
-                object.__setattr__(self, name, freeze(getattr(self, name)))
+        super().__post_init__()  # fige tous les tableaux, ceux du filtre augmenté compris
         object.__setattr__(self, "n_diffuse", int(self.n_diffuse))
 
     def after_diffuse(self) -> FilterResult:
