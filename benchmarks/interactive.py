@@ -40,7 +40,7 @@ def _pages() -> list[str]:
     root = Path(__file__).resolve().parent.parent
     toc = yaml.safe_load((root / "_toc.yml").read_text())
     files = [toc["root"]] + [c["file"] for part in toc["parts"] for c in part["chapters"]]
-    return [f"{f}.html" for f in files if Path(f).name != "references"]
+    return [f"{f}.html" for f in files if Path(f).name not in ("references", "errata")]  # annexes sans curseurs
 
 
 PAGES = _pages()
