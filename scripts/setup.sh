@@ -55,7 +55,8 @@ TEX_PACKAGES=(texlive-xetex texlive-lang-french texlive-latex-recommended texliv
 tex_ready() {
   command -v xelatex >/dev/null && command -v latexmk >/dev/null && command -v pdftotext >/dev/null \
     && kpsewhich polyglossia.sty >/dev/null && kpsewhich hyph-fr.tex >/dev/null \
-    && kpsewhich fncychap.sty >/dev/null && fc-list | grep -q FreeSerif
+    && kpsewhich fncychap.sty >/dev/null && [ -n "$(fc-list FreeSerif)" ]
+  # pas de « fc-list | grep -q » : avec pipefail, grep -q qui s'arrête tôt fait échouer fc-list (SIGPIPE)
 }
 if [ "$want_pdf" = 1 ] && ! tex_ready; then
   apt_install "TeX Live pour le PDF (XeLaTeX, français)" "${TEX_PACKAGES[@]}"
