@@ -205,6 +205,9 @@ def test_errata_appendix_has_the_corrections_the_chapters_did_not_cover():
     labels = _errata_labels()
     for number in ("000-1", "000-3", "000-11", "002-1", "002-2", "002-6", "004-5", "004-6"):
         assert f"errata-{number}" in labels, number
+    # et toutes les corrections des notes de l'EKF itéré sur SE(3), celles que le chapitre fait sans encadré comprises
+    for number in range(1, 15):
+        assert f"errata-004-{number}" in labels, f"004-{number}"
     # chaque entrée : écrit, correct, pourquoi, vérifié par
     entries = re.split(r"^\(errata-[\w-]+\)=$", (BOOK / "errata.md").read_text(), flags=re.M)[1:]
     assert len(entries) == len(labels)
