@@ -131,6 +131,61 @@ def test_no_cell_output_is_an_error(built_book):
             assert marker not in html, f"{page.name} : sortie d'erreur « {marker} »"
 
 
+# Sorties visibles des cellules de code : texte imprimé (print) et valeur de la dernière expression.
+_CELL_OUTPUT = re.compile(r'<div class="output (?:stream|text_plain)\b[^"]*"[^>]*>(.*?)</pre>', re.S)
+# Nombres à l'anglaise : 0.95, -3.25 ; écriture e (1e-06, 3.1127e-04, 1e+00) ; flottants de numpy
+# « 0. » devant « , » ou « ] ». Pas : 2.0.0 (version), a.png, x1.5, 10.1115/… (chemin), 1:30.
+_ENGLISH_NUMBER = re.compile(
+    r"(?<![\w.,/:\u2212-])[-\u2212]?\d+\.\d+(?![\w/]|\.\d)"
+    r"|(?<![\w.])\d+(?:\.\d+)?e[-+]?\d+(?!\w)"
+    r"|(?<![\w.,/:\u2212-])[-\u2212]?\d+\.(?= *[,\]])"
+)
+
+
+def english_numbers_in_outputs(html: str) -> list[str]:
+    """Les nombres écrits à l'anglaise dans les sorties visibles des cellules de code d'une page HTML
+    (chacun avec un peu de contexte) ; le code des cellules, la prose et les figures ne sont pas lus."""
+    found = []
+    for block in _CELL_OUTPUT.findall(html):
+        text = htmllib.unescape(re.sub(r"<[^>]+>", "", block))
+        for m in _ENGLISH_NUMBER.finditer(text):
+            found.append(" ".join(text[max(0, m.start() - 25):m.end() + 10].split()))
+    return found
+
+
+def test_output_check_flags_english_numbers_in_outputs_only():
+    """Sur des pages écrites ici : les sorties à l'anglaise sont signalées, les sorties en français,
+    le code des cellules, les versions et les noms de fichiers ne le sont pas."""
+    def output(kind: str, text: str) -> str:
+        return (f'<div class="cell_output docutils container"><div class="output {kind} highlight-myst-ansi '
+                f'notranslate"><div class="highlight"><pre><span></span>{text}</pre></div></div></div>')
+
+    code = '<div class="cell_input docutils container"><pre>x = 0.5 ; eps = 1e-6 ; print(x)</pre></div>'
+    good = (code + output("stream", "A =\n [[0,95  0,03]\n [0,02  0,96]]\nP∞ = 3,1127 × 10⁻⁴ V²")
+            + output("text_plain", "écart : 1,0 × 10⁻¹⁷ ; filterpy 2.0.0, figure a.png, x1.5, 10:30")
+            + "<p>Prose : 0.5 (vérifiée ailleurs)</p>")
+    assert english_numbers_in_outputs(good) == []
+    bad = (code + output("stream", "A =\n [[0.95 0.03]\n [0.02 0.96]]\n|1 − KC| = 0.60")
+           + output("stream", "P = &nbsp;&nbsp;1e+00 V² ; écart 1.0408340855860843e-17 ; P∞ = 3.1127e-04 V²")
+           + output("text_plain", "(2, array([0.       , 0.2970297, 0.2970297]), array([-3.]))"))
+    found = english_numbers_in_outputs(bad)
+    assert len(found) == 5 + 3 + 4, found
+    assert any("0.60" in f for f in found) and any("1e+00" in f for f in found)
+
+
+@pytest.mark.book
+def test_cell_outputs_write_french_numbers(built_book):
+    """Ce que les cellules impriment est écrit à la française (kc.numbers.format_number,
+    kc.numbers.format_array) : aucun « 0.95 », « 1e-06 » ni tableau numpy brut."""
+    problems = []
+    for page in sorted((built_book / "book").glob("*.html")):
+        found = english_numbers_in_outputs(page.read_text())
+        if found:
+            problems.append(f"{page.name} : {len(found)} nombre(s) à l'anglaise dans la sortie des cellules, "
+                            f"par exemple {found[:3]} (écrire avec kc.numbers.format_number ou format_array)")
+    assert not problems, "\n".join(problems)
+
+
 @pytest.mark.book
 @pytest.mark.parametrize("chapter", ALL_CHAPTERS)
 def test_chapter_pages_show_math_figures_and_glued_numbers(built_book, chapter):
