@@ -241,7 +241,11 @@ def test_live_sliders_are_log_sliders_with_real_values():
     assert explorer.values() == {"Q": Q, "R": R, "P0": P0}  # la valeur lue est la vraie valeur
     explorer.sliders["R"].value = 3e-3
     assert explorer.sliders["R"].value == 3e-3
-    assert format(3e-3, explorer.sliders["R"].readout_format) == "0.003"
+    # la valeur lue est écrite en français à côté du curseur, et suit le curseur
+    assert explorer.sliders["R"].readout is False
+    assert explorer.readouts["R"].value == "3\u202f×\u202f10⁻³\u00a0V²"  # comme les curseurs du livre
+    explorer.sliders["Q"].value = 2.5e-5
+    assert explorer.readouts["Q"].value == "2,5\u202f×\u202f10⁻⁵\u00a0V²"
     bundle = explorer._repr_mimebundle_()
     assert "application/vnd.jupyter.widget-view+json" in bundle
 

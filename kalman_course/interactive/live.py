@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core.validation import KalmanInputError, as_float_array
 from ..numbers import format_spec
+from .grid import format_value
 from .spec import Panel, check_columns, draw_panels, fill_glyph
 
 __all__ = ["LogParameter", "LinearParameter", "ChoiceParameter", "LiveExplorer"]
@@ -64,7 +65,7 @@ class LogParameter:
             max=self.max_exp,
             step=self.step,
             description=f"{self.description} ({self.unit})",
-            readout_format=".3g",
+            readout=False,  # valeur écrite en français à côté (LiveExplorer.readouts)
             continuous_update=False,
             style={"description_width": "14em"},
             layout=widgets.Layout(width="36em"),
@@ -102,7 +103,7 @@ class LinearParameter:
         return widgets.FloatSlider(
             value=float(self.value), min=self.low, max=self.high, step=self.step,
             description=f"{self.description} ({self.unit})" if self.unit else self.description,
-            readout_format=".3g", continuous_update=False,
+            readout=False, continuous_update=False,  # valeur écrite en français à côté
             style={"description_width": "14em"}, layout=widgets.Layout(width="36em"),
         )
 
@@ -161,7 +162,8 @@ class LiveExplorer:
     readout : fonction ``(séries, valeurs) -> str``, optionnelle
         Texte affiché au-dessus de la figure (les nombres de l'exécution courante).
 
-    Attributs utiles : ``sliders`` (dict nom → ``FloatLogSlider``), ``series`` (la dernière
+    Attributs utiles : ``sliders`` (dict nom → ``FloatLogSlider``), ``readouts`` (dict nom → ``Label`` :
+    la valeur d'un curseur numérique écrite en français), ``series`` (la dernière
     exécution), ``lines`` (dict nom de série → liste de ``Line2D`` tracées), ``figure``, ``widget``.
     """
 
@@ -198,9 +200,16 @@ class LiveExplorer:
         self.image = widgets.Image(format="png", value=self._png())
         self.readout = readout
         self.text = widgets.HTML(value=self._text())
+        # la valeur lue d'un curseur numérique, écrite en français (le widget écrirait « 0.003 ») ;
+        # un curseur à positions discrètes affiche déjà son libellé
+        self._units = {p.name: p.unit for p in self.parameters if not isinstance(p, ChoiceParameter)}
+        self.readouts = {name: widgets.Label(value=format_value(self.sliders[name].value, unit))
+                         for name, unit in self._units.items()}
         for slider in self.sliders.values():
             slider.observe(self._on_change, names="value")
-        self.widget = widgets.VBox([*self.sliders.values(), self.text, self.image])
+        rows = [widgets.HBox([slider, self.readouts[name]]) if name in self.readouts else slider
+                for name, slider in self.sliders.items()]
+        self.widget = widgets.VBox([*rows, self.text, self.image])
 
     # ------------------------------------------------------------------ calcul et dessin
 
@@ -265,6 +274,8 @@ class LiveExplorer:
         self.text.value = self._text()
 
     def _on_change(self, change) -> None:
+        for name, label in self.readouts.items():
+            label.value = format_value(self.sliders[name].value, self._units[name])
         self.redraw()
 
     # ------------------------------------------------------------------ affichage Jupyter
