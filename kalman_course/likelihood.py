@@ -568,26 +568,24 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
     # mesures
     obs = ~np.isnan(Y)
     terms = np.empty((T, m, m))
-    for k in range(T):
+    full, none = obs.all(axis=1), ~obs.any(axis=1)
+    e = Y[full] - xs[full] @ C.T  # lignes complètes, d'un bloc
+    terms[full] = e[:, :, None] * e[:, None, :] + C @ Ps[full] @ C.T
+    terms[none] = R
+    for k in np.flatnonzero(~full & ~none):  # lignes partielles
         o = obs[k]
-        if o.all():
-            e = Y[k] - C.dot(xs[k])
-            terms[k] = np.outer(e, e) + C.dot(Ps[k]).dot(C.T)
-        elif not o.any():
-            terms[k] = R
-        else:
-            io, im = np.flatnonzero(o), np.flatnonzero(~o)
-            Co = C[io]
-            e = Y[k, io] - Co.dot(xs[k])
-            Eo = np.outer(e, e) + Co.dot(Ps[k]).dot(Co.T)
-            Roo, Rmo = R[np.ix_(io, io)], R[np.ix_(im, io)]
-            W = scipy.linalg.solve(Roo, Rmo.T, assume_a="pos").T  # R_mo R_oo⁻¹
-            M = np.zeros((m, io.size))
-            M[io] = np.eye(io.size)
-            M[im] = W
-            block = np.zeros((m, m))
-            block[np.ix_(im, im)] = R[np.ix_(im, im)] - W.dot(Rmo.T)
-            terms[k] = M.dot(Eo).dot(M.T) + block
+        io, im = np.flatnonzero(o), np.flatnonzero(~o)
+        Co = C[io]
+        e = Y[k, io] - Co.dot(xs[k])
+        Eo = np.outer(e, e) + Co.dot(Ps[k]).dot(Co.T)
+        Roo, Rmo = R[np.ix_(io, io)], R[np.ix_(im, io)]
+        W = scipy.linalg.solve(Roo, Rmo.T, assume_a="pos").T  # R_mo R_oo⁻¹
+        M = np.zeros((m, io.size))
+        M[io] = np.eye(io.size)
+        M[im] = W
+        block = np.zeros((m, m))
+        block[np.ix_(im, im)] = R[np.ix_(im, im)] - W.dot(Rmo.T)
+        terms[k] = M.dot(Eo).dot(M.T) + block
     R_new = terms.mean(axis=0)
     new = LinearGaussianModel(A, C, symmetrize(Q_new), symmetrize(R_new), model.B)
     return ll, new
