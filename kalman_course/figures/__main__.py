@@ -83,8 +83,14 @@ def build_parser() -> argparse.ArgumentParser:
 def write_figure(name: str, out: Path, formats: list[str], dpi: int) -> int:
     """Dessine la figure ``name`` et l'écrit dans ``out`` dans chaque format ; renvoie le nombre de
     fichiers écrits. Date retirée des métadonnées et identifiants SVG déterministes (réglage local à
-    cet appel) : deux régénérations écrivent les mêmes octets, quel que soit le processus."""
-    with matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
+    cet appel) : deux régénérations écrivent les mêmes octets, quel que soit le processus. L'algèbre
+    linéaire (BLAS) n'utilise qu'un fil pendant l'appel (threadpoolctl)."""
+    from threadpoolctl import threadpool_limits
+
+    # BLAS sur un seul fil : les figures tournent déjà en parallèle (un processus par cœur) ; les fils
+    # d'OpenBLAS en plus se disputent les cœurs (attente active) et multiplient le temps CPU des gros
+    # produits (nuages de particules) sans rien changer aux résultats.
+    with threadpool_limits(limits=1, user_api="blas"), matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
         fig = draw(name)
         for fmt in formats:
             fig.savefig(out / f"{name}.{fmt}", dpi=dpi, metadata=_FIXED_METADATA[fmt])
