@@ -70,6 +70,8 @@ def range_bearing(x: np.ndarray) -> np.ndarray:
 
     Forme (2,) pour un état, (N, 2) pour une pile d'états (N, n) (modèle vectorisé)."""
     x = np.asarray(x)
+    if x.ndim == 1:  # un seul état : sans np.stack (appelée à chaque pas et à chaque itération des filtres)
+        return np.array([np.hypot(x[0], x[1]), np.arctan2(x[1], x[0])])
     return np.stack([np.hypot(x[..., 0], x[..., 1]), np.arctan2(x[..., 1], x[..., 0])], axis=-1)
 
 
