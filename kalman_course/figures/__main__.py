@@ -2,7 +2,8 @@
 ou ``--list`` (nom, description et chapitre de chaque figure).
 
 Chaque figure est dessinée et écrite par un seul processus (``--jobs N`` en répartit les figures
-sur ``N`` processus) ; une barre de progression (tqdm, sur la sortie d'erreur) compte les figures.
+sur ``N`` processus, chapitre par chapitre : les figures d'un chapitre partagent leurs calculs) ; une
+barre de progression (tqdm, sur la sortie d'erreur) compte les figures.
 """
 
 from __future__ import annotations
@@ -97,6 +98,21 @@ def write_figure(name: str, out: Path, formats: list[str], dpi: int) -> int:
     return len(formats)
 
 
+def write_figures(names: list[str], out: Path, formats: list[str], dpi: int) -> int:
+    """:func:`write_figure` pour chaque figure de ``names``, dans ce processus ; renvoie le nombre de fichiers."""
+    return sum(write_figure(name, out, formats, dpi) for name in names)
+
+
+def chapter_groups(names: list[str]) -> list[list[str]]:
+    """Les figures ``names`` réunies par chapitre (un lot par processus) : les figures d'un chapitre
+    partagent leurs expériences (fonctions des scénarios mises en cache), calculées ainsi une seule fois.
+    Les lots les plus nombreux d'abord (répartition entre processus), à égalité dans l'ordre du registre."""
+    groups: dict[str, list[str]] = {}
+    for name in names:
+        groups.setdefault(REGISTRY[name].chapter, []).append(name)
+    return sorted(groups.values(), key=len, reverse=True)
+
+
 def _pool(jobs: int) -> ProcessPoolExecutor:
     # « fork » : les processus héritent du paquet déjà importé (démarrage immédiat) ; sinon « spawn ».
     method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
@@ -129,12 +145,14 @@ def main(argv: list[str] | None = None) -> int:
         for name in tqdm(selected, desc="figures", unit="fig", file=sys.stderr):
             written += write_figure(name, args.out, formats, args.dpi)
     else:
+        groups = chapter_groups(selected)
+        jobs = min(jobs, len(groups))
         with _pool(jobs) as pool:
-            futures = [pool.submit(write_figure, name, args.out, formats, args.dpi) for name in selected]
-            with tqdm(total=len(futures), desc=f"figures ({jobs} processus)", unit="fig", file=sys.stderr) as bar:
+            futures = {pool.submit(write_figures, group, args.out, formats, args.dpi): len(group) for group in groups}
+            with tqdm(total=len(selected), desc=f"figures ({jobs} processus)", unit="fig", file=sys.stderr) as bar:
                 for future in as_completed(futures):
                     written += future.result()
-                    bar.update()
+                    bar.update(futures[future])
     print(f"{written} fichier(s) écrit(s) dans {args.out}")
     return 0
 
