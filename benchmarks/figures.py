@@ -42,13 +42,16 @@ def timed_command(out: Path, *args: str) -> float:
 
 
 def main() -> None:
+    from threadpoolctl import threadpool_limits
+
     total = 0.0
-    for name in kc.figures.names():
-        start, cpu = time.perf_counter(), time.process_time()
-        kc.figures.draw(name)
-        elapsed = time.perf_counter() - start
-        total += elapsed
-        print(f"{name:32s} {elapsed:6.2f} s ({time.process_time() - cpu:5.2f} s CPU)")
+    with threadpool_limits(limits=1, user_api="blas"):  # comme la commande (BLAS sur un fil)
+        for name in kc.figures.names():
+            start, cpu = time.perf_counter(), time.process_time()
+            kc.figures.draw(name)
+            elapsed = time.perf_counter() - start
+            total += elapsed
+            print(f"{name:32s} {elapsed:6.2f} s ({time.process_time() - cpu:5.2f} s CPU)")
     n = len(kc.figures.names())
     print(f"{'calcul et tracé (sans écriture)':32s} {total:6.2f} s")
     cores = os.cpu_count() or 1

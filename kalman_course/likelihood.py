@@ -48,7 +48,7 @@ import scipy.differentiate
 import scipy.linalg
 import scipy.optimize
 
-from .core.linalg import symmetrize
+from .core.linalg import S_NOT_PD, symmetrize
 from .core.models import LinearGaussianModel
 from .core.results import FilterResult, freeze
 from .core.validation import KalmanInputError, as_controls, as_float_array, as_measurements, check_instance, shape_text
@@ -68,6 +68,7 @@ __all__ = [
     "log_likelihood_terms",
     "filter_log_likelihood",
     "log_likelihood",
+    "log_likelihoods",
     "MaximumLikelihood",
     "maximum_likelihood",
     "EMResult",
@@ -198,6 +199,101 @@ def log_likelihood(model: LinearGaussianModel, y: Any, x0: Any = None, P0: Any =
     return _diffuse_value(augmented, J[-1], h[-1])
 
 
+def log_likelihoods(models: Any, y: Any) -> np.ndarray:
+    r"""Vraisemblances **diffuses exactes** de plusieurs modèles de mêmes dimensions sur les mêmes mesures,
+    calculées en lot (une grille de paramètres, les points d'une hessienne).
+
+    Même calcul que :func:`log_likelihood` sans ``x0`` ni ``P0`` (voir le module), mais la récurrence du
+    filtre augmenté :math:`[a \mid X]` porte sur les ``G`` modèles à la fois (tableaux (G, …)) : à chaque
+    pas, :math:`[a^- \mid X^-] = A[a \mid X]`, :math:`P^- = AP A^T + Q`, puis, si ``y[k]`` est observée,
+    :math:`S = CP^-C^T + R = LL^T` (Cholesky), :math:`[v \mid -E] = [y \mid 0] - C[a^- \mid X^-]`,
+    :math:`K = P^-C^TS^{-1}`, :math:`[a \mid X] = [a^- \mid X^-] + K[v \mid -E]`, :math:`P = P^- - KCP^-`,
+    en cumulant :math:`\sum\log|S_k|`, :math:`\sum v_k^TS_k^{-1}v_k`, :math:`J = \sum E_k^TS_k^{-1}E_k`,
+    :math:`h = \sum E_k^TS_k^{-1}v_k`.
+
+    Paramètres
+    ----------
+    models : suite de ``G`` :class:`~kalman_course.LinearGaussianModel` de mêmes ``n`` et ``m``, sans
+        commande.
+    y : (T, m), ou (T,) si m = 1 — ``NaN`` : mesure manquante. Une ligne partiellement observée fait
+        calculer chaque modèle par :func:`log_likelihood` (même résultat, sans le lot).
+
+    Renvoie (G,) : les :math:`\log L_d` (nats), égales à celles de :func:`log_likelihood` aux arrondis près.
+    """
+    models = list(models) if not isinstance(models, LinearGaussianModel) else [models]
+    if not models:
+        raise KalmanInputError("« models » doit contenir au moins un modèle.")
+    for i, model in enumerate(models):
+        check_instance(f"models[{i}]", model, LinearGaussianModel, "la vraisemblance est celle d'un modèle linéaire gaussien")
+    n, m = models[0].n_state, models[0].n_obs
+    for i, model in enumerate(models):
+        if model.n_state != n or model.n_obs != m:
+            raise KalmanInputError(
+                f"« models[{i}] » a n = {model.n_state}, m = {model.n_obs} ; le premier modèle a n = {n}, m = {m} : "
+                "le lot demande des modèles de mêmes dimensions."
+            )
+        if model.B is not None:
+            raise KalmanInputError(f"« models[{i}] » a une commande B : le lot n'en prend pas ; utilisez log_likelihood.")
+    Y = as_measurements("y", y, m)
+    obs = ~np.isnan(Y)
+    full, some = obs.all(axis=1), obs.any(axis=1)
+    if (some & ~full).any():  # lignes partielles : le calcul modèle par modèle
+        return np.array([log_likelihood(model, Y) for model in models])
+    A = np.stack([model.A for model in models])
+    C = np.stack([model.C for model in models])
+    Q = np.stack([model.Q for model in models])
+    R = np.stack([model.R for model in models])
+    G = len(models)
+    At, Ct = np.swapaxes(A, 1, 2), np.swapaxes(C, 1, 2)
+    xa = None
+    logdet = np.zeros(G)
+    quad = np.zeros(G)
+    J = np.zeros((G, n, n))
+    h = np.zeros((G, n))
+    n_obs = 0
+    for k in range(Y.shape[0]):
+        if xa is None:  # première prédiction : [a⁻ | X⁻] = [0 | I], P⁻ = 0
+            xa = np.zeros((G, n, n + 1))
+            xa[:, :, 1:] = np.eye(n)
+            P = np.zeros((G, n, n))
+        else:
+            xa = A @ xa
+            P = symmetrize(A @ P @ At + Q)
+        if not full[k]:
+            continue
+        V = -(C @ xa)  # [v | -E], (G, m, 1+n)
+        V[:, :, 0] += Y[k]
+        PCt = P @ Ct
+        S = C @ PCt + R
+        try:
+            L = np.linalg.cholesky(S)
+        except np.linalg.LinAlgError:
+            raise KalmanInputError(f"{S_NOT_PD[:-1]} (au pas {k}).") from None
+        W = np.linalg.solve(L, V)  # L⁻¹[v | -E]
+        logdet += 2.0 * np.sum(np.log(np.diagonal(L, axis1=1, axis2=2)), axis=1)
+        w = W[:, :, 0]
+        quad += np.sum(w * w, axis=1)
+        WE = W[:, :, 1:]  # -L⁻¹E
+        J += np.swapaxes(WE, 1, 2) @ WE
+        h -= (np.swapaxes(WE, 1, 2) @ w[:, :, None])[:, :, 0]
+        Kt = np.linalg.solve(S, np.swapaxes(PCt, 1, 2))  # Kᵀ = S⁻¹CP⁻
+        K = np.swapaxes(Kt, 1, 2)
+        xa = xa + K @ V
+        P = symmetrize(P - K @ np.swapaxes(PCt, 1, 2))
+        n_obs += m
+    J = symmetrize(J)
+    det = is_determined(J)
+    if not det.all():
+        raise KalmanInputError(
+            f"Les mesures ne déterminent pas l'état pour « models[{int(np.argmin(det))}] » (information J_T "
+            "singulière : modèle non observable ou trop peu de mesures) : la vraisemblance diffuse n'est pas définie."
+        )
+    LJ = np.linalg.cholesky(J)
+    wJ = np.linalg.solve(LJ, h[:, :, None])[:, :, 0]
+    return (-0.5 * (n_obs * LOG_2PI + logdet + quad) + 0.5 * np.sum(wJ * wJ, axis=1)
+            - np.sum(np.log(np.diagonal(LJ, axis1=1, axis2=2)), axis=1))
+
+
 # --------------------------------------------------------------------------- maximum de vraisemblance
 
 
@@ -271,19 +367,19 @@ def _same_model(a: LinearGaussianModel, b: LinearGaussianModel) -> bool:
     return all(x.shape == y.shape and np.array_equal(x, y) for x, y in pairs)
 
 
-def _hessian(f: Callable[[np.ndarray], float], theta: np.ndarray) -> np.ndarray:
+def _hessian(f: Callable[[np.ndarray], np.ndarray], theta: np.ndarray) -> np.ndarray:
     r"""Hessienne de ``f`` en ``theta`` par ``scipy.differentiate.hessian`` (différences finies et
     extrapolation de Richardson). Les paramètres sont d'abord ramenés à l'échelle 1
     (:math:`\theta = \hat\theta + Ds`, :math:`D = \operatorname{diag}(\max(1, |\hat\theta_i|))`, d'où
-    :math:`\nabla^2_\theta f = D^{-1}\nabla^2_s f D^{-1}`) ; ``f`` n'est pas vectorisée : on boucle."""
+    :math:`\nabla^2_\theta f = D^{-1}\nabla^2_s f D^{-1}`) ; ``f`` est vectorisée : elle reçoit les
+    points d'essai en colonnes, (q, N), et renvoie leurs N valeurs (tous les points d'une itération
+    de ``scipy.differentiate`` sont évalués en un seul lot)."""
     scale = np.maximum(1.0, np.abs(theta))
 
     def vectorised(s: np.ndarray) -> np.ndarray:
         s = np.asarray(s)
-        out = np.empty(s.shape[1:])
-        for idx in np.ndindex(*s.shape[1:]):
-            out[idx] = f(theta + scale * s[(slice(None),) + idx])
-        return out
+        points = theta[:, None] + scale[:, None] * s.reshape(s.shape[0], -1)
+        return np.asarray(f(points), dtype=float).reshape(s.shape[1:])
 
     res = scipy.differentiate.hessian(vectorised, np.zeros_like(theta), initial_step=0.05, order=4, maxiter=2)
     H = np.asarray(res.ddf, dtype=float) / np.outer(scale, scale)
@@ -365,7 +461,21 @@ def maximum_likelihood(
     theta = np.asarray(opt.x, dtype=float)
     model = _call_build(build, theta, "theta")
     ll = log_likelihood(model, Y, x0, P0, U)
-    H = _hessian(loglik, theta)
+    def loglik_batch(points: np.ndarray) -> np.ndarray:
+        r""":math:`\log L` aux colonnes de ``points`` (q, N) : en lot (:func:`log_likelihoods`) au départ
+        diffus sans commande, sinon (ou si un point est refusé) point par point."""
+        if x0 is None and U is None:
+            try:
+                models = [build(np.array(p, dtype=float)) for p in points.T]
+                if all(isinstance(mdl, LinearGaussianModel) and mdl.B is None for mdl in models):
+                    with np.errstate(over="ignore", invalid="ignore"):
+                        values = log_likelihoods(models, Y)
+                    return np.where(np.isfinite(values), values, -np.inf)
+            except KalmanInputError:
+                pass
+        return np.array([loglik(p) for p in points.T])
+
+    H = _hessian(loglik_batch, theta)
     q = theta.size
     cov = np.full((q, q), np.nan)
     se = np.full(q, np.nan)
@@ -458,26 +568,24 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
     # mesures
     obs = ~np.isnan(Y)
     terms = np.empty((T, m, m))
-    for k in range(T):
+    full, none = obs.all(axis=1), ~obs.any(axis=1)
+    e = Y[full] - xs[full] @ C.T  # lignes complètes, d'un bloc
+    terms[full] = e[:, :, None] * e[:, None, :] + C @ Ps[full] @ C.T
+    terms[none] = R
+    for k in np.flatnonzero(~full & ~none):  # lignes partielles
         o = obs[k]
-        if o.all():
-            e = Y[k] - C.dot(xs[k])
-            terms[k] = np.outer(e, e) + C.dot(Ps[k]).dot(C.T)
-        elif not o.any():
-            terms[k] = R
-        else:
-            io, im = np.flatnonzero(o), np.flatnonzero(~o)
-            Co = C[io]
-            e = Y[k, io] - Co.dot(xs[k])
-            Eo = np.outer(e, e) + Co.dot(Ps[k]).dot(Co.T)
-            Roo, Rmo = R[np.ix_(io, io)], R[np.ix_(im, io)]
-            W = scipy.linalg.solve(Roo, Rmo.T, assume_a="pos").T  # R_mo R_oo⁻¹
-            M = np.zeros((m, io.size))
-            M[io] = np.eye(io.size)
-            M[im] = W
-            block = np.zeros((m, m))
-            block[np.ix_(im, im)] = R[np.ix_(im, im)] - W.dot(Rmo.T)
-            terms[k] = M.dot(Eo).dot(M.T) + block
+        io, im = np.flatnonzero(o), np.flatnonzero(~o)
+        Co = C[io]
+        e = Y[k, io] - Co.dot(xs[k])
+        Eo = np.outer(e, e) + Co.dot(Ps[k]).dot(Co.T)
+        Roo, Rmo = R[np.ix_(io, io)], R[np.ix_(im, io)]
+        W = scipy.linalg.solve(Roo, Rmo.T, assume_a="pos").T  # R_mo R_oo⁻¹
+        M = np.zeros((m, io.size))
+        M[io] = np.eye(io.size)
+        M[im] = W
+        block = np.zeros((m, m))
+        block[np.ix_(im, im)] = R[np.ix_(im, im)] - W.dot(Rmo.T)
+        terms[k] = M.dot(Eo).dot(M.T) + block
     R_new = terms.mean(axis=0)
     new = LinearGaussianModel(A, C, symmetrize(Q_new), symmetrize(R_new), model.B)
     return ll, new

@@ -168,3 +168,14 @@ def test_cli_bad_input_gives_french_error_and_nonzero_exit(tmp_path, args, messa
     assert message in proc.stderr
     assert "erreur :" in proc.stderr and "utilisation :" in proc.stderr
     assert not any(tmp_path.iterdir())  # rien n'est écrit
+
+
+def test_cli_chapter_groups_keep_each_figure_once_with_its_chapter():
+    from kalman_course.figures.__main__ import chapter_groups
+
+    names = kc.figures.names()
+    groups = chapter_groups(names)
+    assert sorted(n for g in groups for n in g) == sorted(names)
+    for group in groups:
+        assert len({kc.figures.REGISTRY[n].chapter for n in group}) == 1
+    assert [len(g) for g in groups] == sorted((len(g) for g in groups), reverse=True)

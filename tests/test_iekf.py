@@ -199,3 +199,25 @@ def test_stored_innovation_and_S_come_from_the_last_linearisation():
     np.testing.assert_allclose(res.x, res.x_pred + np.einsum("kij,kj->ki", res.K, res.innovation), atol=1e-9)
     nis = kc.nis(res)
     assert np.isfinite(nis).all() and 1.0 < nis.mean() < 3.0  # χ²₂ : moyenne 2
+
+
+def test_map_costs_on_a_grid_equal_the_cost_point_by_point():
+    """Le lot (courbes de niveau de la figure) contre la formule point par point, et contre le calcul
+    direct ½dᵀP⁻¹d + ½rᵀR⁻¹r par inverses explicites (angles ramenés dans (−π, π])."""
+    p = radar.radar_update_problem()
+    xs, ys, J = radar.radar_cost_grid(p, n=7)
+    Pi, Ri = np.linalg.inv(p.P_pred), np.linalg.inv(p.model.R)
+    for i in (0, 3, 6):
+        for j in (0, 2, 6):
+            x = np.array([xs[j], ys[i]])
+            assert J[i, j] == pytest.approx(kc.map_cost(p.model, x, p.x_pred, p.P_pred, p.y), rel=1e-12)
+            r = p.y - np.array([np.hypot(*x), np.arctan2(x[1], x[0])])
+            r[1] = (r[1] + np.pi) % (2 * np.pi) - np.pi
+            d = x - p.x_pred
+            assert J[i, j] == pytest.approx(0.5 * d @ Pi @ d + 0.5 * r @ Ri @ r, rel=1e-9)
+
+
+def test_error_map_costs_needs_points_in_rows():
+    p = radar.radar_update_problem()
+    with pytest.raises(kc.KalmanInputError, match="« X »"):
+        kc.filters.iterated.map_costs(p.model, [1.0, 2.0], p.x_pred, p.P_pred, p.y)

@@ -115,6 +115,45 @@ def test_log_likelihood_equals_the_joint_density_of_the_measurements(n, m, p):
     np.testing.assert_allclose(kc.log_likelihood(model, y, u=u), batch_log_likelihood(model, y, u), rtol=1e-9)
 
 
+@pytest.mark.parametrize("missing", [False, True])
+def test_batched_log_likelihoods_equal_statsmodels_on_a_grid(missing):
+    """Le lot (grille de paramètres du chapitre) contre statsmodels point par point."""
+    y = kc.datasets.nile(missing=missing).flow
+    grid = [(e, q) for e in (3000.0, 15099.0, 80000.0) for q in (20.0, 1469.1, 50000.0)]
+    ours = kc.likelihood.log_likelihoods([_nile_model("llevel", g) for g in grid], y)
+    mod = sm.tsa.UnobservedComponents(y, "llevel", use_exact_diffuse=True)
+    ref = np.array([mod.loglike(list(g)) for g in grid])
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("n,m", [(1, 1), (2, 1), (3, 2), (2, 3)])
+def test_batched_log_likelihoods_equal_the_joint_density(n, m):
+    rng = np.random.default_rng(700 + 10 * n + m)
+    models = [random_model(rng, n, m, 0) for _ in range(3)]
+    y = np.array(kc.simulate(models[0], rng.standard_normal(n), 20, rng=rng).y)
+    y[[3, 12]] = np.nan
+    ours = kc.likelihood.log_likelihoods(models, y)
+    np.testing.assert_allclose(ours, [batch_log_likelihood(mdl, y) for mdl in models], rtol=1e-9)
+    if m > 1:  # ligne partielle : le calcul modèle par modèle, même résultat
+        y[7, 0] = np.nan
+        np.testing.assert_allclose(kc.likelihood.log_likelihoods(models, y),
+                                   [batch_log_likelihood(mdl, y) for mdl in models], rtol=1e-9)
+
+
+def test_batched_log_likelihoods_refuse_bad_input():
+    y = kc.datasets.nile().flow
+    with pytest.raises(kc.KalmanInputError, match="au moins un modèle"):
+        kc.likelihood.log_likelihoods([], y)
+    with pytest.raises(kc.KalmanInputError, match="models\\[1\\]"):
+        kc.likelihood.log_likelihoods([_nile_model("llevel", NILE_LLEVEL), "pas un modèle"], y)
+    with pytest.raises(kc.KalmanInputError, match="mêmes dimensions"):
+        kc.likelihood.log_likelihoods([_nile_model("llevel", NILE_LLEVEL), _nile_model("lltrend", NILE_LLTREND)], y)
+    with pytest.raises(kc.KalmanInputError, match="commande"):
+        kc.likelihood.log_likelihoods([kc.LinearGaussianModel(1.0, 1.0, 1.0, 1.0, B=1.0)], y)
+    with pytest.raises(kc.KalmanInputError, match="déterminent pas"):
+        kc.likelihood.log_likelihoods([_nile_model("lltrend", NILE_LLTREND)], y[:1])
+
+
 def test_terms_sum_to_the_log_likelihood_and_missing_steps_add_nothing():
     y = kc.datasets.nile(missing=True).flow
     model = _nile_model("llevel", NILE_LLEVEL)

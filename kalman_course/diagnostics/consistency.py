@@ -88,6 +88,15 @@ def _cholesky_or_error(M: np.ndarray, name: str, k: int) -> np.ndarray:
         ) from None
 
 
+def _forward_substitution(L: np.ndarray, v: np.ndarray) -> np.ndarray:
+    r""":math:`L_k^{-1}v_k` pour tous les pas à la fois, par descente :
+    :math:`w_i = (v_i - \sum_{j<i} L_{ij}w_j)/L_{ii}`. ``L`` (T, d, d) triangulaires inférieures, ``v`` (T, d)."""
+    w = np.empty_like(v)
+    for i in range(v.shape[1]):
+        w[:, i] = (v[:, i] - np.sum(L[:, i, :i] * w[:, :i], axis=1)) / L[:, i, i]
+    return w
+
+
 def _whiten(vectors: np.ndarray, covs: np.ndarray, mask: np.ndarray, cov_name: str) -> np.ndarray:
     r"""Pour chaque pas :math:`k`, :math:`L_k^{-1} v_k` sur les composantes ``mask[k]`` (Cholesky
     :math:`L_kL_k^T` du bloc correspondant de ``covs[k]``), NaN ailleurs. Formes (T, d), (T, d, d), (T, d)."""
@@ -98,13 +107,15 @@ def _whiten(vectors: np.ndarray, covs: np.ndarray, mask: np.ndarray, cov_name: s
         idx = np.flatnonzero(full)
         block = covs[idx]
         try:
-            L = scipy.linalg.cholesky(block, lower=True, check_finite=True)
+            if not np.isfinite(block).all():
+                raise ValueError
+            L = np.linalg.cholesky(block)  # tout le lot en un appel (LAPACK en boucle C)
         except (np.linalg.LinAlgError, ValueError):
             # le lot a échoué : on cherche le pas fautif pour le nommer
             for k in idx:
                 _cholesky_or_error(covs[k], cov_name, int(k))
             raise  # pragma: no cover  (toujours levée ci-dessus)
-        out[idx] = scipy.linalg.solve_triangular(L, vectors[idx][..., None], lower=True)[..., 0]
+        out[idx] = _forward_substitution(L, vectors[idx])
     for k in np.flatnonzero(~full & mask.any(axis=1)):
         sel = np.flatnonzero(mask[k])
         L = _cholesky_or_error(covs[k][np.ix_(sel, sel)], cov_name, int(k))

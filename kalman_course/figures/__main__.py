@@ -2,7 +2,8 @@
 ou ``--list`` (nom, description et chapitre de chaque figure).
 
 Chaque figure est dessinée et écrite par un seul processus (``--jobs N`` en répartit les figures
-sur ``N`` processus) ; une barre de progression (tqdm, sur la sortie d'erreur) compte les figures.
+sur ``N`` processus, chapitre par chapitre : les figures d'un chapitre partagent leurs calculs) ; une
+barre de progression (tqdm, sur la sortie d'erreur) compte les figures.
 """
 
 from __future__ import annotations
@@ -83,12 +84,33 @@ def build_parser() -> argparse.ArgumentParser:
 def write_figure(name: str, out: Path, formats: list[str], dpi: int) -> int:
     """Dessine la figure ``name`` et l'écrit dans ``out`` dans chaque format ; renvoie le nombre de
     fichiers écrits. Date retirée des métadonnées et identifiants SVG déterministes (réglage local à
-    cet appel) : deux régénérations écrivent les mêmes octets, quel que soit le processus."""
-    with matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
+    cet appel) : deux régénérations écrivent les mêmes octets, quel que soit le processus. L'algèbre
+    linéaire (BLAS) n'utilise qu'un fil pendant l'appel (threadpoolctl)."""
+    from threadpoolctl import threadpool_limits
+
+    # BLAS sur un seul fil : les figures tournent déjà en parallèle (un processus par cœur) ; les fils
+    # d'OpenBLAS en plus se disputent les cœurs (attente active) et multiplient le temps CPU des gros
+    # produits (nuages de particules) sans rien changer aux résultats.
+    with threadpool_limits(limits=1, user_api="blas"), matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
         fig = draw(name)
         for fmt in formats:
             fig.savefig(out / f"{name}.{fmt}", dpi=dpi, metadata=_FIXED_METADATA[fmt])
     return len(formats)
+
+
+def write_figures(names: list[str], out: Path, formats: list[str], dpi: int) -> int:
+    """:func:`write_figure` pour chaque figure de ``names``, dans ce processus ; renvoie le nombre de fichiers."""
+    return sum(write_figure(name, out, formats, dpi) for name in names)
+
+
+def chapter_groups(names: list[str]) -> list[list[str]]:
+    """Les figures ``names`` réunies par chapitre (un lot par processus) : les figures d'un chapitre
+    partagent leurs expériences (fonctions des scénarios mises en cache), calculées ainsi une seule fois.
+    Les lots les plus nombreux d'abord (répartition entre processus), à égalité dans l'ordre du registre."""
+    groups: dict[str, list[str]] = {}
+    for name in names:
+        groups.setdefault(REGISTRY[name].chapter, []).append(name)
+    return sorted(groups.values(), key=len, reverse=True)
 
 
 def _pool(jobs: int) -> ProcessPoolExecutor:
@@ -123,12 +145,14 @@ def main(argv: list[str] | None = None) -> int:
         for name in tqdm(selected, desc="figures", unit="fig", file=sys.stderr):
             written += write_figure(name, args.out, formats, args.dpi)
     else:
+        groups = chapter_groups(selected)
+        jobs = min(jobs, len(groups))
         with _pool(jobs) as pool:
-            futures = [pool.submit(write_figure, name, args.out, formats, args.dpi) for name in selected]
-            with tqdm(total=len(futures), desc=f"figures ({jobs} processus)", unit="fig", file=sys.stderr) as bar:
+            futures = {pool.submit(write_figures, group, args.out, formats, args.dpi): len(group) for group in groups}
+            with tqdm(total=len(selected), desc=f"figures ({jobs} processus)", unit="fig", file=sys.stderr) as bar:
                 for future in as_completed(futures):
                     written += future.result()
-                    bar.update()
+                    bar.update(futures[future])
     print(f"{written} fichier(s) écrit(s) dans {args.out}")
     return 0
 

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..filters.iterated import map_cost
-from ..scenarios.radar import radar_iterations
+from ..scenarios.radar import radar_cost_grid, radar_iterations
 from ._geometry import draw_ellipse
 from ._registry import new_figure, register
 
@@ -19,10 +18,8 @@ def iekf_iterations():
     p = it.problem
     fig, (ax, ac) = new_figure(1, 2, width=9.5, height=5.4, gridspec_kw={"width_ratios": [1.2, 1]})
 
-    # plan : courbes de niveau du coût J(x), sur une grille de 4 cm (100 × 100 évaluations de map_cost)
-    xs = np.linspace(7.0, 10.6, 100)
-    ys = np.linspace(-0.5, 3.9, 100)
-    J = np.array([[map_cost(p.model, [x, y], p.x_pred, p.P_pred, p.y) for x in xs] for y in ys])
+    # plan : courbes de niveau du coût J(x), sur une grille de 4 cm (100 × 100 évaluations du coût, en lot)
+    xs, ys, J = radar_cost_grid(p)
     levels = [1, 3, 10, 30, 100, 300, 1000, 3000]
     cs = ax.contour(xs, ys, J, levels=levels, cmap="viridis_r", linewidths=0.9)
     ax.clabel(cs, fontsize=6, fmt="%g")

@@ -15,7 +15,7 @@ import scipy.linalg
 from ..core.linalg import cholesky_factor
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult
-from ..core.validation import as_gaussian, as_vector
+from ..core.validation import KalmanInputError, as_float_array, as_gaussian, as_vector, shape_text
 from .engine import Correction, FilterFamily, gaussian_moments, gaussian_prior, run_filter
 from .extended import NONLINEAR_HINT, check_model, linearize_observation, predict_moments
 from .iteration import (
@@ -27,7 +27,7 @@ from .iteration import (
     gauss_newton_update,
 )
 
-__all__ = ["IteratedUpdate", "iekf_update", "map_cost", "iterated_extended_kalman_filter", "iterated_family"]
+__all__ = ["IteratedUpdate", "iekf_update", "map_cost", "map_costs", "iterated_extended_kalman_filter", "iterated_family"]
 
 
 class IteratedUpdate(NamedTuple):
@@ -115,6 +115,26 @@ def map_cost(model: NonlinearModel, x: Any, x_pred: Any, P_pred: Any, y: Any) ->
     d = x_arr - xp
     r = model.residual(y_arr, model.observe(x_arr))
     return float(0.5 * d.dot(scipy.linalg.cho_solve(cP, d)) + 0.5 * r.dot(scipy.linalg.cho_solve(cR, r)))
+
+
+def map_costs(model: NonlinearModel, X: Any, x_pred: Any, P_pred: Any, y: Any) -> np.ndarray:
+    r"""Le coût MAP :math:`J(x)` de :func:`map_cost` en ``N`` points à la fois (une grille pour des
+    courbes de niveau) : ``X`` (N, n) ; renvoie (N,). Les vérifications et les factorisations de
+    Cholesky de :math:`P^-` et :math:`R` sont faites une fois ; :math:`h` est appelée une fois sur la
+    pile si le modèle est vectorisé (``vectorized=True``), sinon point par point."""
+    model = check_model(model)
+    n = model.n_state
+    X_arr = as_float_array("X", X)
+    if X_arr.ndim != 2 or X_arr.shape[1] != n:
+        raise KalmanInputError(f"« X » doit être de forme (N, {n}) : un point par ligne ; reçu {shape_text(X_arr.shape)}.")
+    xp, Pp = as_gaussian(x_pred, P_pred, n, "x_pred", "P_pred")
+    y_arr = as_vector("y", y, model.n_obs)
+    cP = (cholesky_factor(Pp, "P_pred", "définie positive pour évaluer le coût MAP"), True)
+    cR = (cholesky_factor(model.measurement_noise(xp), "R", "définie positive"), True)
+    D = (X_arr - xp).T  # (n, N)
+    Rr = model.residual(y_arr[:, None], model.observe_many(X_arr).T)  # (m, N), angles ramenés
+    return (0.5 * np.sum(D * scipy.linalg.cho_solve(cP, D), axis=0)
+            + 0.5 * np.sum(Rr * scipy.linalg.cho_solve(cR, Rr), axis=0))
 
 
 # --------------------------------------------------------------------------- boucle

@@ -352,7 +352,9 @@ def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> Smo
     Xs = xs_a[:, :, 1:]
     cho = scipy.linalg.cho_factor(J, lower=True)
     delta = scipy.linalg.cho_solve(cho, h)
-    JiXt = np.stack([scipy.linalg.cho_solve(cho, Xk.T) for Xk in Xs])  # J⁻¹Xₖᵀ, (T, n, n)
+    T = Xs.shape[0]  # J⁻¹Xₖᵀ pour tous les pas d'une seule résolution : J⁻¹[X₀ᵀ … X_{T-1}ᵀ]
+    JiXt = scipy.linalg.cho_solve(cho, np.swapaxes(Xs, 1, 2).transpose(1, 0, 2).reshape(n, T * n))
+    JiXt = JiXt.reshape(n, T, n).transpose(1, 0, 2)  # (T, n, n)
     xs = xs_a[:, :, 0] + Xs @ delta
     Ps = symmetrize(Ps_a + Xs @ JiXt)
     lag = np.full_like(Ps, np.nan)

@@ -45,6 +45,7 @@ from ..likelihood import (
     expectation_maximization,
     filter_log_likelihood,
     log_likelihood,
+    log_likelihoods,
     maximum_likelihood,
 )
 
@@ -149,7 +150,7 @@ def likelihood_surface(n: int = 25, missing: bool = False) -> LikelihoodSurface:
     y = nile(missing).flow
     eps = np.logspace(3.0, 5.0, n)
     eta = np.logspace(1.0, 5.0, n)
-    ll = np.array([[log_likelihood(local_level_model(e, q), y) for e in eps] for q in eta])
+    ll = log_likelihoods([local_level_model(e, q) for q in eta for e in eps], y).reshape(n, n)  # en lot
     return LikelihoodSurface(eps, eta, ll)
 
 

@@ -19,7 +19,7 @@ import numpy as np
 import scipy.optimize
 
 from ..filters.extended import ekf_update
-from ..filters.iterated import iekf_update, map_cost
+from ..filters.iterated import iekf_update, map_cost, map_costs
 from ..lecture.errata_iekf import no_correction_iterates, table_literal_iterates
 from ..core.models import NonlinearModel
 from ..core.results import freeze, freeze_fields
@@ -28,6 +28,7 @@ from ..tables import Table
 from ._motion import cv_process_noise, cv_transition, simulate_cv
 
 __all__ = [
+    "radar_cost_grid",
     "RADAR_PRIOR",
     "RADAR_PRIOR_COV",
     "RADAR_TRUTH",
@@ -69,6 +70,8 @@ def range_bearing(x: np.ndarray) -> np.ndarray:
 
     Forme (2,) pour un état, (N, 2) pour une pile d'états (N, n) (modèle vectorisé)."""
     x = np.asarray(x)
+    if x.ndim == 1:  # un seul état : sans np.stack (appelée à chaque pas et à chaque itération des filtres)
+        return np.array([np.hypot(x[0], x[1]), np.arctan2(x[1], x[0])])
     return np.stack([np.hypot(x[..., 0], x[..., 1]), np.arctan2(x[..., 1], x[..., 0])], axis=-1)
 
 
@@ -206,6 +209,17 @@ def radar_iterations(
         no_correction=freeze(no_correction_iterates(p.model, p.x_pred, p.P_pred, p.y, max_iter=wrong_max_iter)),
         converged=bool(out.converged),
     )
+
+
+def radar_cost_grid(problem: RadarUpdateProblem | None = None, n: int = 100):
+    r"""Le coût MAP :math:`J(x)` du problème radar sur une grille de ``n`` × ``n`` points (4 cm pour
+    ``n = 100``) du plan :math:`[7; 10{,}6] \times [-0{,}5; 3{,}9]` m, pour ses courbes de niveau.
+    Renvoie ``(xs (n,), ys (n,), J (n, n))``, ligne : ``ys``, colonne : ``xs``."""
+    p = radar_update_problem() if problem is None else problem
+    xs = np.linspace(7.0, 10.6, n)
+    ys = np.linspace(-0.5, 3.9, n)
+    X = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
+    return xs, ys, map_costs(p.model, X, p.x_pred, p.P_pred, p.y).reshape(n, n)
 
 
 # --------------------------------------------------------------------------- suivi d'une cible
