@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import re
+from functools import lru_cache
 from typing import Any
 
 from babel.numbers import format_decimal
@@ -29,6 +30,7 @@ __all__ = [
     "format_spec",
     "format_array",
     "matplotlib_formatter",
+    "matplotlib_log_formatter",
     "french_figure",
     "bokeh_tick_formatter",
     "glue_number",
@@ -61,8 +63,10 @@ def _check_digits(name: str, value: Any, minimum: int) -> int:
     return value
 
 
+@lru_cache(maxsize=8192)
 def _fixed(x: float, decimals: int, group: bool = True, trim: bool = False) -> str:
-    # « # » : chiffre décimal facultatif (zéros finals retirés) ; « 0 » : chiffre toujours écrit
+    # « # » : chiffre décimal facultatif (zéros finals retirés) ; « 0 » : chiffre toujours écrit.
+    # En cache : les graduations d'une figure sont réécrites à chaque mise en page et à chaque tracé.
     digit = "#" if trim else "0"
     pattern = ("#,##0" if group else "0") + ("." + digit * decimals if decimals > 0 else "")
     text = format_decimal(round(x, decimals) + 0.0, format=pattern, locale=LOCALE)
@@ -242,14 +246,70 @@ def matplotlib_formatter():
     return FrenchScalarFormatter()
 
 
+_LOG_LABEL = re.compile(r"^(?P<sign>-?)(?:(?P<mantissa>[0-9.]+)\\times\s*)?10\^\{(?P<exponent>-?[0-9]+)\}$")
+
+
+def _french_log_label(label: str) -> str:
+    r"""Une étiquette ``LogFormatterSciNotation`` (mathtext ``$\mathdefault{3\times10^{-2}}$``) écrite
+    en texte : « 3 × 10⁻² », « 10⁻² », « −10² », ou le nombre lui-même (« 0,5 ») ; inchangée sinon."""
+    inner = re.fullmatch(r"\$\\mathdefault\{(.*)\}\$", label)
+    if inner is None:
+        return label
+    found = _LOG_LABEL.match(inner[1])
+    if found is not None:
+        sign = MINUS if found["sign"] else ""
+        power = f"10{str(int(found['exponent'])).translate(_SUPERSCRIPT)}"
+        if found["mantissa"] is None:
+            return sign + power
+        mantissa = format_number(float(found["mantissa"]), significant=6, trim=True)
+        return f"{sign}{mantissa}{NNBSP}×{NNBSP}{power}"
+    try:
+        value = float(inner[1])
+    except ValueError:  # autre base (« 2^{3} ») : laissée telle quelle
+        return label
+    return format_number(value, significant=6, trim=True)
+
+
+def matplotlib_log_formatter():
+    r"""Formateur de graduations matplotlib pour les axes logarithmiques en base 10, en français : les
+    graduations et le choix des étiquettes de ``LogFormatterSciNotation``, écrites en texte Unicode
+    (« 10⁻² », « 3 × 10⁻² », signe moins typographique) plutôt qu'en formule mathtext — même lecture,
+    et aucune formule à composer pour chaque graduation."""
+    from matplotlib.ticker import LogFormatterSciNotation
+
+    class FrenchLogFormatter(LogFormatterSciNotation):
+        """``LogFormatterSciNotation`` dont les étiquettes passent par :func:`_french_log_label`."""
+
+        def __call__(self, x: float, pos: int | None = None) -> str:
+            return _french_log_label(super().__call__(x, pos))
+
+    return FrenchLogFormatter()
+
+
+def _figure_texts(artist):
+    """Les textes d'une figure : titres, libellés, légendes, annotations, cellules de tableau… Les
+    graduations sont laissées (réécrites par leur formateur à chaque tracé) : on ne descend pas dans
+    les axes (``Axis``, qui fabriquerait toutes ses graduations), seulement dans leur libellé."""
+    from matplotlib.axis import Axis
+    from matplotlib.text import Text
+
+    if isinstance(artist, Axis):
+        yield artist.label
+        return
+    if isinstance(artist, Text):
+        yield artist
+    for child in artist.get_children():
+        yield from _figure_texts(child)
+
+
 def french_figure(figure) -> None:
     """Une figure matplotlib à la française : graduations des axes linéaires par
-    :func:`matplotlib_formatter` (les formateurs choisis par la figure elle-même, logarithmiques ou
-    autres, sont laissés) et typographie des textes — titres, légendes, libellés, annotations — par
+    :func:`matplotlib_formatter`, des axes logarithmiques (notation scientifique de matplotlib) par
+    :func:`matplotlib_log_formatter` (les autres formateurs choisis par la figure sont laissés) et
+    typographie des textes — titres, légendes, libellés, annotations — par
     :func:`kalman_course.book_typography.french_spacing` (espaces insécables, apostrophe « ’ »,
     formules ``$…$`` intactes)."""
-    from matplotlib.text import Text
-    from matplotlib.ticker import ScalarFormatter
+    from matplotlib.ticker import LogFormatterSciNotation, ScalarFormatter
 
     from .book_typography import french_spacing
 
@@ -257,9 +317,15 @@ def french_figure(figure) -> None:
         for axis in (ax.xaxis, ax.yaxis, getattr(ax, "zaxis", None)):
             if axis is None:
                 continue
-            if type(axis.get_major_formatter()) is ScalarFormatter:
+            major, minor = axis.get_major_formatter(), axis.get_minor_formatter()
+            if type(major) is ScalarFormatter:
                 axis.set_major_formatter(matplotlib_formatter())
-    for text in figure.findobj(Text):
+            for formatter, setter in ((major, axis.set_major_formatter), (minor, axis.set_minor_formatter)):
+                if type(formatter) is LogFormatterSciNotation:
+                    replacement = matplotlib_log_formatter()
+                    replacement.__dict__.update(formatter.__dict__)  # même base, mêmes étiquettes choisies
+                    setter(replacement)
+    for text in _figure_texts(figure):
         old = text.get_text()
         new = french_spacing(old)
         if new != old:

@@ -125,8 +125,19 @@ def test_matplotlib_axes_get_french_ticks():
     assert _tick_labels(ax.yaxis) == [f"{M}0,50", f"{M}0,25", "0,00", "0,25", "0,50", "0,75", "1,00", "1,25",
                                       "1,50"]
     assert _tick_labels(ax.xaxis)[:3] == ["0,0", "0,2", "0,4"]
-    # l'axe logarithmique garde son formateur (puissances de dix)
-    assert type(second.yaxis.get_major_formatter()).__name__.startswith("LogFormatter")
+    # l'axe logarithmique garde les graduations de matplotlib, écrites en texte (pas en formule)
+    assert {"10⁻³", "10⁻²", "10⁻¹", "10⁰"} <= set(_tick_labels(second.yaxis))
+    assert not any("$" in t for t in _tick_labels(second.yaxis))
+
+
+def test_log_axis_minor_labels_are_french():
+    fig, ax = kc.figures.new_figure()
+    ax.set_yscale("log")
+    ax.set_ylim(0.02, 0.08)  # moins d'une décade : matplotlib étiquette aussi les graduations secondaires
+    french_figure(fig)
+    fig.savefig(io.BytesIO(), format="png")
+    minor = [t.get_text() for t in ax.yaxis.get_minorticklabels() if t.get_text()]
+    assert f"3{NN}×{NN}10⁻²" in minor and f"6{NN}×{NN}10⁻²" in minor, minor
 
 
 def test_matplotlib_formatter_writes_a_common_power_of_ten():

@@ -23,6 +23,9 @@ from . import REGISTRY, draw
 FORMATS = ("png", "svg", "pdf")
 # Métadonnées sans date : des fichiers identiques d'une régénération à l'autre.
 _FIXED_METADATA = {"png": None, "svg": {"Date": None}, "pdf": {"CreationDate": None}}
+# Compression zlib des PNG : niveau 3 plutôt que 6 (défaut de Pillow) : fichiers ≈ 5 % plus gros,
+# écriture ≈ 40 % plus rapide (0,045 s contre 0,076 s pour une figure de 1 200 × 825 pixels).
+_SAVE_OPTIONS = {"png": {"pil_kwargs": {"compress_level": 3}}, "svg": {}, "pdf": {}}
 
 
 class _FrenchHelpFormatter(argparse.HelpFormatter):
@@ -94,7 +97,7 @@ def write_figure(name: str, out: Path, formats: list[str], dpi: int) -> int:
     with threadpool_limits(limits=1, user_api="blas"), matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
         fig = draw(name)
         for fmt in formats:
-            fig.savefig(out / f"{name}.{fmt}", dpi=dpi, metadata=_FIXED_METADATA[fmt])
+            fig.savefig(out / f"{name}.{fmt}", dpi=dpi, metadata=_FIXED_METADATA[fmt], **_SAVE_OPTIONS[fmt])
     return len(formats)
 
 
@@ -111,6 +114,18 @@ def chapter_groups(names: list[str]) -> list[list[str]]:
     for name in names:
         groups.setdefault(REGISTRY[name].chapter, []).append(name)
     return sorted(groups.values(), key=len, reverse=True)
+
+
+def _warm_up() -> None:
+    """Construit une fois, avant de créer les processus, l'analyseur des formules mathtext de matplotlib
+    (≈ 0,1 s) : les processus créés par « fork » en héritent au lieu de le reconstruire chacun."""
+    import io
+
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(1.0, 1.0))
+    figure.text(0.1, 0.1, r"$\hat x_k$")
+    figure.savefig(io.BytesIO(), format="png")
 
 
 def _pool(jobs: int) -> ProcessPoolExecutor:
@@ -147,6 +162,7 @@ def main(argv: list[str] | None = None) -> int:
     else:
         groups = chapter_groups(selected)
         jobs = min(jobs, len(groups))
+        _warm_up()
         with _pool(jobs) as pool:
             futures = {pool.submit(write_figures, group, args.out, formats, args.dpi): len(group) for group in groups}
             with tqdm(total=len(selected), desc=f"figures ({jobs} processus)", unit="fig", file=sys.stderr) as bar:

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..datasets.nile import nile
 from ..likelihood import log_likelihood
-from ..numbers import format_number, matplotlib_formatter
+from ..numbers import format_number, matplotlib_formatter, matplotlib_log_formatter
 from ..scenarios.nile import (
     NILE_DK_VARIANCES,
     diffuse_limit,
@@ -51,9 +51,7 @@ def _level_panel(ax, run, title: str, filtered: bool = True) -> None:
 
 def decades(axis) -> None:
     """Graduations d'un axe logarithmique en puissances de dix (10⁶ ; aucune décimale à écrire)."""
-    from matplotlib.ticker import LogFormatterSciNotation
-
-    axis.set_major_formatter(LogFormatterSciNotation())
+    axis.set_major_formatter(matplotlib_log_formatter())
 
 
 def _year_formatter():
