@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..core.models import NonlinearModel
-from ..core.results import freeze_fields
+from ..core.results import FilterResult, FilterRuns, freeze_fields
 from ..core.simulation import as_generator, check_positive_int
 from ..diagnostics.consistency import nees
 from ..filters.extended import extended_kalman_filter_runs
@@ -120,6 +120,17 @@ class FilterComparison:
                 for name in self.position_error}
 
 
+def _runs_nees(x_true: np.ndarray, runs: FilterRuns) -> np.ndarray:
+    r"""NEES (N, T) de chaque tirage et de chaque pas : la NEES ne dépend que du pas, on la calcule en un
+    appel de :func:`~kalman_course.nees` sur les :math:`N T` pas mis bout à bout."""
+    N, T, n = runs.x.shape
+    flat = FilterResult(x=runs.x.reshape(N * T, n), P=runs.P.reshape(N * T, n, n), x_pred=runs.x_pred.reshape(N * T, n),
+                        P_pred=runs.P_pred.reshape(N * T, n, n), K=runs.K.reshape(N * T, n, -1),
+                        innovation=runs.innovation.reshape(N * T, -1), S=runs.S.reshape(N * T, *runs.S.shape[-2:]),
+                        observed=runs.observed.reshape(N * T, -1), n_iter=runs.n_iter.reshape(N * T))
+    return nees(x_true.reshape(N * T, n), flat).reshape(N, T)
+
+
 def distant_target_comparison(n_runs: int = TARGET_RUNS, rng: Any = TARGET_SEED,
                               n_steps: int = TARGET_STEPS) -> FilterComparison:
     r"""EKF, UKF (:data:`TARGET_UKF`) et EKF itéré sur ``n_runs`` tirages de :func:`distant_target_run` : erreur de
@@ -145,5 +156,5 @@ def distant_target_comparison(n_runs: int = TARGET_RUNS, rng: Any = TARGET_SEED,
     for name, run_filter in filters.items():
         result = run_filter()
         err[name] = np.mean(np.linalg.norm(result.x[..., :2] - x_true[..., :2], axis=-1), axis=0)
-        eps[name] = np.mean([nees(x_true[i], result.run(i)) for i in range(n_runs)], axis=0)
+        eps[name] = np.mean(_runs_nees(x_true, result), axis=0)
     return FilterComparison(t=TARGET_DT * np.arange(1, n_steps + 1), position_error=err, nees=eps, n_runs=n_runs)
