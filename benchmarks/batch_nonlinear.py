@@ -92,7 +92,7 @@ def main() -> None:
     with threadpool_limits(1, "blas"):
         print(f"Cible lointaine : {Y.shape[0]} tirages × {Y.shape[1]} pas, temps CPU, meilleur de {REPEAT}, BLAS sur 1 fil")
         for name, (single, batch) in pairs.items():
-            t_one, ref = best_cpu(lambda: [single(r) for r in runs])
+            t_one, ref = best_cpu(lambda single=single: [single(r) for r in runs])
             t_lot, res = best_cpu(batch)
             gap = max(float(np.max(np.abs(res.x[i] - ref[i].x))) for i in range(len(runs)))
             print(f"  {name:<10} tirage par tirage {fr(t_one)} s, en lot {fr(t_lot)} s : "

@@ -29,7 +29,14 @@ from ..core.angles import wrap_angle
 from ..core.linalg import correct, correct_many, symmetrize
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, FilterRuns
-from ..core.validation import KalmanInputError, as_gaussian, as_vector, call_user_function, check_control_allowed, check_instance
+from ..core.validation import (
+    KalmanInputError,
+    as_gaussian,
+    as_vector,
+    call_user_function,
+    check_control_allowed,
+    check_instance,
+)
 from .engine import (
     Correction,
     FilterFamily,

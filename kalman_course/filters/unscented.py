@@ -306,7 +306,7 @@ def _points_many(X: np.ndarray, P: np.ndarray, scale: float, where: str, what: s
 
 
 def _ukf_predict_many(model, X, P, u, Wm, Wc, scale, k):
-    N, n = X.shape
+    n = X.shape[1]
     pts = _points_many(X, P, scale, f"prédiction vers y[{k}]", "a posteriori P")
     Xf = model.transition_many(pts.reshape(-1, n), u).reshape(pts.shape)
     X_pred = Wm @ Xf                                   # (N, n)
