@@ -18,6 +18,9 @@ import pytest
 
 import kalman_course as kc
 from conftest import filterpy_kf, random_model
+from kalman_course.filters.extended import extended_kalman_filter_runs
+from kalman_course.filters.iterated import iterated_extended_kalman_filter_runs
+from kalman_course.filters.unscented import unscented_kalman_filter_runs
 
 TOL = dict(atol=1e-9, rtol=1e-9)
 
@@ -54,6 +57,13 @@ FILTERS = [
     Member("SRIF étendu", lambda m, y, x0, P0, u=None: kc.extended_square_root_information_filter(
         _nonlinear(m), y, x0, P0, u)),
     Member("UKF (α=1, β=2, κ=0)", _ukf),
+    # mode en lot du moteur (run_filter_runs), sur un lot d'un tirage
+    Member("EKF en lot", lambda m, y, x0, P0, u=None: extended_kalman_filter_runs(
+        _nonlinear(m), np.asarray(y)[None], x0, P0, u).run(0)),
+    Member("EKF itéré en lot", lambda m, y, x0, P0, u=None: iterated_extended_kalman_filter_runs(
+        _nonlinear(m), np.asarray(y)[None], x0, P0, u).run(0)),
+    Member("UKF en lot", lambda m, y, x0, P0, u=None: unscented_kalman_filter_runs(
+        _nonlinear(m), np.asarray(y)[None], x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0).run(0)),
 ]
 IDS = [f.name for f in FILTERS]
 
@@ -139,8 +149,8 @@ BAD_INPUTS = [
 ]
 
 
-@pytest.mark.parametrize("member", [f for f in FILTERS if not f.name.startswith(("SRIF (", "KF en lot"))],
-                         ids=[f.name for f in FILTERS if not f.name.startswith(("SRIF (", "KF en lot"))])
+@pytest.mark.parametrize("member", [f for f in FILTERS if not f.name.startswith("SRIF (") and "en lot" not in f.name],
+                         ids=[f.name for f in FILTERS if not f.name.startswith("SRIF (") and "en lot" not in f.name])
 @pytest.mark.parametrize("bad, message", BAD_INPUTS)
 def test_same_bad_input_errors(member, bad, message):
     model, y, x0, P0, u = _case(1, 3, 2, 1, T=5)

@@ -13,7 +13,9 @@ import scipy.linalg
 
 from .validation import KalmanInputError
 
-__all__ = ["symmetrize", "kalman_gain", "correct", "cholesky_factor", "covariance_factor"]
+__all__ = [
+    "symmetrize", "kalman_gain", "correct", "solve_pd_many", "correct_many", "cholesky_factor", "covariance_factor",
+]
 
 _posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
 
@@ -65,6 +67,56 @@ def correct(x_pred: np.ndarray, P_pred: np.ndarray, nu: np.ndarray, H: np.ndarra
     else:
         P = P_pred - K.dot(PHt.T)
     return x, symmetrize(P), K, S
+
+
+def solve_pd_many(S: np.ndarray, B: np.ndarray, name: str, message: str, where: str = "") -> np.ndarray:
+    r"""Résout :math:`S_i X_i = B_i` pour une pile de matrices définies positives, par Cholesky.
+
+    ``S`` (N, m, m), ``B`` (N, m, q) ; renvoie ``X`` (N, m, q). Si une :math:`S_i` n'est pas définie
+    positive : :class:`KalmanInputError` avec ``message``, le premier tirage fautif et ``where``."""
+    try:
+        L = np.linalg.cholesky(S)
+    except np.linalg.LinAlgError:
+        bad = next(i for i in range(S.shape[0]) if not _is_pd(S[i]))
+        place = f"tirage {bad}" + (f", {where}" if where else "")
+        raise KalmanInputError(f"{message[:-1]} ({name}, {place}).") from None
+    return np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, B))
+
+
+def _is_pd(M: np.ndarray) -> bool:
+    try:
+        np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        return False
+    return True
+
+
+def correct_many(X_pred: np.ndarray, P_pred: np.ndarray, nu: np.ndarray, H: np.ndarray, R: np.ndarray,
+                 joseph: bool = False, where: str = ""):
+    r"""La correction linéaire de :func:`correct` sur ``N`` tirages à la fois (mêmes formules, tirage par
+    tirage) :
+
+    .. math::
+
+        S_i = H_iP^-_iH_i^T + R_i,\quad K_i = P^-_iH_i^TS_i^{-1},\quad x_i = x^-_i + K_i
+u_i,\quad
+        P_i = (I - K_iH_i)P^-_i\ \ 	ext{ou (Joseph)}\ \ (I-K_iH_i)P^-_i(I-K_iH_i)^T + K_iR_iK_i^T.
+
+    ``X_pred`` (N, n), ``P_pred`` (N, n, n), ``nu`` (N, m) ; ``H`` (m, n) commune ou (N, m, n) ;
+    ``R`` (m, m) commune ou (N, m, m). :math:`K_i` vient de la résolution de :math:`S_iK_i^T = H_iP^-_i`
+    par Cholesky (jamais d'inverse). Renvoie ``(X (N, n), P (N, n, n), K (N, n, m), S (N, m, m))``.
+    """
+    Ht = np.swapaxes(H, -1, -2)
+    PHt = P_pred @ Ht                                   # (N, n, m)
+    S = H @ PHt + R                                     # (N, m, m)
+    K = np.swapaxes(solve_pd_many(S, np.swapaxes(PHt, -1, -2), "S", S_NOT_PD, where), -1, -2)
+    X = X_pred + (K @ nu[..., None])[..., 0]
+    if joseph:
+        IKH = np.eye(P_pred.shape[-1]) - K @ H
+        P = IKH @ P_pred @ np.swapaxes(IKH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2)
+    else:
+        P = P_pred - K @ np.swapaxes(PHt, -1, -2)
+    return X, symmetrize(P), K, S
 
 
 def cholesky_factor(M: np.ndarray, name: str, what: str = "définie positive", lower: bool = True) -> np.ndarray:

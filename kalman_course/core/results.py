@@ -98,12 +98,14 @@ class FilterResult:
 
 @dataclass(frozen=True, eq=False, repr=False)
 class FilterRuns(FilterResult):
-    r"""Les résultats de ``N`` tirages filtrés ensemble (:func:`~kalman_course.kalman_filter_runs`) : les
+    r"""Les résultats de ``N`` tirages filtrés ensemble (:func:`~kalman_course.kalman_filter_runs`, et les
+    filtres non linéaires en lot de :func:`~kalman_course.filters.engine.run_filter_runs`) : les
     champs de :class:`FilterResult` avec un axe des tirages en tête — ``x`` (N, T, n),
-    ``innovation`` (N, T, m), ``observed`` (N, T, m), ``n_iter`` (N, T) — sauf les covariances et le
-    gain, qui ne dépendent pas des mesures quand aucune n'est manquante : ``P``, ``P_pred`` (T, n, n),
-    ``K`` (T, n, m), ``S`` (T, m, m) sont alors communs à tous les tirages (``shared_covariance``), et
-    sinon de forme (N, T, …)."""
+    ``innovation`` (N, T, m), ``observed`` (N, T, m), ``n_iter`` (N, T) — sauf, pour le filtre de
+    Kalman linéaire sans mesure manquante, les covariances et le gain, qui ne dépendent alors pas des
+    mesures : ``P``, ``P_pred`` (T, n, n), ``K`` (T, n, m), ``S`` (T, m, m) sont communs à tous les
+    tirages (``shared_covariance``) ; sinon (mesures manquantes, filtres non linéaires, dont la
+    linéarisation dépend de chaque tirage) ils sont de forme (N, T, …)."""
 
     @property
     def n_runs(self) -> int:

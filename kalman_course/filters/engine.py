@@ -25,6 +25,12 @@ vérifier le modèle, ``y``, ``u``, l'a priori ; traiter les mesures manquantes 
 prédiction seule ; ligne partielle : correction avec les seules composantes observées) ; assembler le
 résultat immuable, temps en premier (:class:`~kalman_course.core.results.FilterResult`). Les erreurs
 d'entrée sont donc les mêmes pour tous les filtres.
+
+**Tirages en lot.** Une famille peut aussi fournir ses étapes sur ``N`` tirages indépendants du même
+modèle (``prior_many``, ``predict_many``, ``update_many``, axe des tirages en tête) ; :func:`run_filter_runs`
+les enchaîne dans le temps — la même boucle, les mêmes vérifications, les mêmes mesures manquantes — et
+rend un :class:`~kalman_course.core.results.FilterRuns` (``x`` (N, T, n), ``P`` (N, T, n, n)…). Chaque
+tirage y est égal, aux arrondis près, à :func:`run_filter` sur ses seules mesures.
 """
 
 from __future__ import annotations
@@ -35,11 +41,31 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
-from ..core.results import FilterHistory, FilterResult
+from ..core.results import FilterHistory, FilterResult, FilterRuns
 from ..core.simulation import as_generator
-from ..core.validation import KalmanInputError, as_controls, as_gaussian, as_measurements, check_instance
+from ..core.validation import (
+    KalmanInputError,
+    as_controls,
+    as_float_array,
+    as_gaussian,
+    as_measurements,
+    as_square_matrix,
+    check_instance,
+    check_pd,
+    check_psd,
+    shape_text,
+)
 
-__all__ = ["Correction", "FilterFamily", "run_filter", "observed_rows", "gaussian_prior", "gaussian_moments"]
+__all__ = [
+    "Correction",
+    "FilterFamily",
+    "run_filter",
+    "run_filter_runs",
+    "observed_rows",
+    "gaussian_prior",
+    "gaussian_prior_many",
+    "gaussian_moments",
+]
 
 
 class Correction(NamedTuple):
@@ -56,7 +82,7 @@ class Correction(NamedTuple):
 
 @dataclass(frozen=True)
 class FilterFamily:
-    """Les étapes pures d'une famille de filtres, que :func:`run_filter` enchaîne dans le temps.
+    r"""Les étapes pures d'une famille de filtres, que :func:`run_filter` enchaîne dans le temps.
 
     ``name`` : nom français du filtre (messages) ; ``model_type`` : classe(s) de modèle acceptée(s) ;
     ``model_hint`` : piste donnée quand le modèle n'est pas du bon type ; ``result_type`` : classe du
@@ -66,6 +92,14 @@ class FilterFamily:
     ``stochastic`` : les étapes tirent au hasard et reçoivent ``rng=`` (un ``numpy.random.Generator``) ;
     ``step_outputs(state)`` : sorties supplémentaires de chaque pas (dictionnaire de tableaux), empilées
     dans le temps et passées à ``result_type``.
+
+    Mode en lot (facultatif, pour :func:`run_filter_runs`) : ``prior_many(model, x0, P0, N)`` → état
+    interne des ``N`` tirages, un **tuple de tableaux dont le premier axe est celui des tirages** et dont
+    les deux premiers sont :math:`\hat X` (N, n) et :math:`P` (N, n, n) ; ``predict_many(model, state, u_k, k)``
+    → état prédit (``k`` : indice de la mesure visée, pour nommer le pas dans un message) ;
+    ``update_many(model, state, Y_k, idx, k)`` → ``(état corrigé, Correction)``, où ``state`` et ``Y_k``
+    (g, m_k) ne contiennent que les ``g`` tirages qui observent les composantes ``idx`` (``None`` :
+    toutes) et où les champs de la :class:`Correction` ont un axe des tirages en tête (``n_iter`` (g,)).
     """
 
     name: str
@@ -80,11 +114,41 @@ class FilterFamily:
     tangent_dim: Callable[[Any], int] = field(default=lambda model: model.n_state)
     stochastic: bool = False
     step_outputs: Callable[[Any], dict[str, Any]] | None = None
+    prior_many: Callable[[Any, Any, Any, int], Any] | None = None
+    predict_many: Callable[[Any, Any, np.ndarray | None, int], Any] | None = None
+    update_many: Callable[[Any, Any, np.ndarray, np.ndarray | None, int], tuple[Any, Correction]] | None = None
 
 
 def gaussian_prior(model: Any, x0: Any, P0: Any) -> tuple[np.ndarray, np.ndarray]:
     """A priori des filtres gaussiens : ``x0`` (n,), ``P0`` (n, n) symétrique semi-définie positive."""
     return as_gaussian(x0, P0, model.n_state, "x0", "P0")
+
+
+def gaussian_prior_many(model: Any, x0: Any, P0: Any, N: int, definite: bool = False):
+    """A priori de ``N`` tirages : ``x0`` (n,) commun ou (N, n) un par tirage ; ``P0`` (n, n) commune ou
+    (N, n, n) une par tirage, symétrique semi-définie positive (``definite=True`` : définie positive).
+    Renvoie ``(X0 (N, n), P0 (N, n, n))`` (copies)."""
+    n = model.n_state
+    X0 = as_float_array("x0", x0)
+    if X0.shape == (n,):
+        X0 = np.broadcast_to(X0, (N, n))
+    elif X0.shape != (N, n):
+        raise KalmanInputError(
+            f"« x0 » doit être de forme ({n},) (commun) ou ({N}, {n}) (un par tirage) ; reçu {shape_text(X0.shape)}."
+        )
+    check = check_pd if definite else check_psd
+    P = as_float_array("P0", P0)
+    if P.ndim == 3:
+        if P.shape != (N, n, n):
+            raise KalmanInputError(
+                f"« P0 » doit être de forme ({n}, {n}) (commune) ou ({N}, {n}, {n}) (une par tirage) ; "
+                f"reçu {shape_text(P.shape)}."
+            )
+        for i in range(N):
+            check(f"P0[{i}]", P[i])
+    else:
+        P = np.broadcast_to(check("P0", as_square_matrix("P0", P, n)), (N, n, n))
+    return np.array(X0, dtype=float), np.array(P, dtype=float)
 
 
 def gaussian_moments(state: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -168,3 +232,104 @@ def run_filter(
                 extras.setdefault(name, []).append(value)
     return out.result(family.result_type, **{name: np.stack(values) for name, values in extras.items()})
 
+
+
+def _batch_measurements(Y: Any, m: int) -> np.ndarray:
+    """Mesures de ``N`` tirages ``(N, T, m)`` ; ``(N, T)`` accepté si ``m = 1`` ; ``NaN`` : manquante."""
+    arr = as_float_array("Y", Y, allow_nan=True)
+    if arr.ndim == 2 and m == 1:
+        arr = arr[:, :, None]
+    if arr.ndim != 3 or arr.shape[2] != m or arr.shape[0] == 0 or arr.shape[1] == 0:
+        extra = " ou (N, T)" if m == 1 else ""
+        raise KalmanInputError(
+            f"« Y » doit être de forme (N, T, {m}){extra} : N ≥ 1 tirages de T ≥ 1 mesures ; reçu {shape_text(arr.shape)}."
+        )
+    return arr
+
+
+def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, u: Any = None) -> FilterRuns:
+    r"""Applique la famille ``family`` à ``N`` tirages indépendants du même modèle, tous à la fois : à
+    chaque pas, une prédiction puis une correction sur la pile des tirages (axe des tirages en tête).
+
+    C'est la boucle de :func:`run_filter`, dans le même ordre, avec les étapes en lot de la famille
+    (``prior_many``, ``predict_many``, ``update_many``) ; chaque tirage est égal, aux arrondis près, à
+    :func:`run_filter` sur ses mesures ``Y[i]``.
+
+    Mesures manquantes : comme :func:`run_filter`, tirage par tirage. Au pas ``k``, les tirages sont
+    regroupés par motif de composantes observées ; chaque groupe est corrigé ensemble avec ses seules
+    composantes observées, et les tirages sans aucune mesure au pas ``k`` ne font que la prédiction
+    (gain nul, innovation et ``S`` NaN, ``n_iter`` = 0).
+
+    Paramètres
+    ----------
+    model : le modèle de la famille (vérifié).
+    Y : (N, T, m), ou (N, T) si m = 1 — mesures des ``N`` tirages ; ``NaN`` : composante manquante.
+    x0 : (n,) commun ou (N, n) ; P0 : (n, n) commune ou (N, n, n) — vérifiés par ``family.prior_many``.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes **communes** à tous les tirages.
+
+    Renvoie un :class:`~kalman_course.core.results.FilterRuns` : ``x``, ``x_pred`` (N, T, n), ``P``,
+    ``P_pred`` (N, T, n, n), ``K`` (N, T, n, m), ``innovation`` (N, T, m), ``S`` (N, T, m, m),
+    ``observed`` (N, T, m), ``n_iter`` (N, T) ; ``result.run(i)`` est le :class:`FilterResult` du tirage ``i``.
+    """
+    check_instance("model", model, family.model_type, family.model_hint)
+    if family.predict_many is None or family.update_many is None or family.prior_many is None:
+        raise KalmanInputError(
+            f"Le {family.name} n'a pas de mode en lot : filtrez les tirages un par un (boucle sur run_filter)."
+        )
+    m = model.n_obs
+    Yarr = _batch_measurements(Y, m)
+    N, T, _ = Yarr.shape
+    if u is not None and np.ndim(u) == 3:
+        raise KalmanInputError(
+            f"« u » doit être commune à tous les tirages en lot, de forme (T, {model.n_control}) ; reçu "
+            f"{shape_text(np.shape(u))} : pour des commandes propres à chaque tirage, filtrez-les un par un."
+        )
+    U = as_controls("u", u, T, model.n_control)
+    state = family.prior_many(model, x0, P0, N)
+    n = state[0].shape[-1]
+    observed = ~np.isnan(Yarr)
+    xs, xps = np.empty((N, T, n)), np.empty((N, T, n))
+    Ps, Pps = np.empty((N, T, n, n)), np.empty((N, T, n, n))
+    Ks = np.zeros((N, T, n, m))  # gain nul pour une composante manquante : aucune correction
+    nus = np.full((N, T, m), np.nan)
+    Ss = np.full((N, T, m, m), np.nan)
+    n_iter = np.zeros((N, T), dtype=int)
+    full = observed.all(axis=2)  # (N, T)
+    for k in range(T):
+        predicted = family.predict_many(model, state, None if U is None else U[k], k)
+        if full[:, k].all():
+            state, corr = family.update_many(model, predicted, Yarr[:, k], None, k)
+            Ks[:, k], nus[:, k], Ss[:, k], n_iter[:, k] = corr
+        else:
+            state = tuple(np.array(a) for a in predicted)
+            patterns, group = np.unique(observed[:, k], axis=0, return_inverse=True)
+            for g, pattern in enumerate(patterns):
+                if not pattern.any():
+                    continue  # tirages sans mesure à ce pas : prédiction seule
+                runs = np.flatnonzero(group.ravel() == g)
+                idx = None if pattern.all() else np.flatnonzero(pattern)
+                y_g = Yarr[runs, k] if idx is None else Yarr[runs, k][:, idx]
+                new, corr = family.update_many(model, tuple(a[runs] for a in predicted), y_g, idx, k)
+                for a, b in zip(state, new):
+                    a[runs] = b
+                _store_correction(Ks, nus, Ss, n_iter, runs, k, idx, corr)
+        xps[:, k], Pps[:, k] = predicted[0], predicted[1]
+        xs[:, k], Ps[:, k] = state[0], state[1]
+    return FilterRuns(x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss,
+                      observed=observed, n_iter=n_iter)
+
+
+def _store_correction(Ks, nus, Ss, n_iter, runs, k, idx, corr) -> None:
+    """Range la correction d'un groupe de tirages ``runs`` au pas ``k`` (composantes ``idx``)."""
+    n_iter[runs, k] = corr.n_iter
+    if idx is None:
+        Ks[runs, k], nus[runs, k], Ss[runs, k] = corr.K, corr.innovation, corr.S
+        return
+    g, (n, m) = len(runs), Ks.shape[2:]
+    K = np.zeros((g, n, m))
+    K[:, :, idx] = corr.K
+    nu = np.full((g, m), np.nan)
+    nu[:, idx] = corr.innovation
+    S = np.full((g, m, m), np.nan)
+    S[:, idx[:, None], idx] = corr.S
+    Ks[runs, k], nus[runs, k], Ss[runs, k] = K, nu, S

@@ -12,6 +12,11 @@ bruits), :math:`\Phi \to Q`, :math:`\Psi \to R`, :math:`\hat x^-_{n+1} \to` ``x_
   :math:`V R V^T` à la place de :math:`R`.
 
 La correction itérée (Gauss–Newton) est dans :mod:`kalman_course.filters.iterated`.
+
+**Tirages en lot** (:func:`extended_kalman_filter_runs`) : les mêmes étapes sur une pile de ``N`` tirages
+(``X`` (N, n), ``P`` (N, n, n)). :math:`f` et :math:`h` passent par :meth:`NonlinearModel.transition_many`
+et :meth:`NonlinearModel.observe_many` (un appel pour toute la pile si le modèle est vectorisé, un appel
+par tirage sinon) ; les jacobiennes par :func:`transition_jacobians` et :func:`observation_jacobians`.
 """
 
 from __future__ import annotations
@@ -20,14 +25,38 @@ from typing import Any
 
 import numpy as np
 
-from ..core.linalg import correct, symmetrize
+from ..core.angles import wrap_angle
+from ..core.linalg import correct, correct_many, symmetrize
 from ..core.models import NonlinearModel
-from ..core.results import FilterResult
-from ..core.validation import as_gaussian, as_vector, check_control_allowed, check_instance
-from .engine import Correction, FilterFamily, gaussian_moments, gaussian_prior, run_filter
+from ..core.results import FilterResult, FilterRuns
+from ..core.validation import (
+    KalmanInputError,
+    as_gaussian,
+    as_vector,
+    call_user_function,
+    check_control_allowed,
+    check_instance,
+)
+from .engine import (
+    Correction,
+    FilterFamily,
+    gaussian_moments,
+    gaussian_prior,
+    gaussian_prior_many,
+    run_filter,
+    run_filter_runs,
+)
 from .kalman import Prediction, Update
 
-__all__ = ["ekf_predict", "ekf_update", "extended_kalman_filter", "extended_family"]
+__all__ = [
+    "ekf_predict",
+    "ekf_update",
+    "extended_kalman_filter",
+    "extended_kalman_filter_runs",
+    "extended_family",
+    "transition_jacobians",
+    "observation_jacobians",
+]
 
 #: Piste donnée quand un filtre non linéaire reçoit un modèle linéaire.
 NONLINEAR_HINT = "pour un modèle linéaire, utilisez kalman_filter ou NonlinearModel.from_linear"
@@ -76,6 +105,103 @@ def _ekf_correct(model, x_pred, P_pred, y, idx, joseph):
     nu, H, R = linearize_observation(model, x_pred, y, idx)
     x, P, K, S = correct(x_pred, P_pred, nu, H, R, joseph)
     return x, P, K, nu, S
+
+
+# --------------------------------------------------------------------------- noyaux en lot
+
+
+def _stacked_jacobian(model: NonlinearModel, name: str, X: np.ndarray, args: tuple, shape: tuple[int, int],
+                      one: Any) -> np.ndarray:
+    """Jacobienne ``name`` en chaque ligne de ``X`` (N, n) : (N, *shape), ou ``shape`` si elle est constante
+    (commune à tous les tirages, diffusée par les produits matriciels)."""
+    value = getattr(model, name)
+    if value is not None and not callable(value):
+        return value  # constante
+    N = X.shape[0]
+    if value is not None and model.vectorized and N > 1:
+        try:
+            with np.errstate(all="ignore"):  # l'essai sur la pile ne doit rien signaler : il peut échouer
+                J = np.asarray(call_user_function(name, value, X, args), dtype=float)
+        except KalmanInputError:
+            J = None  # elle n'accepte pas de pile : un appel par tirage
+        if J is not None and J.shape == (N, *shape) and np.isfinite(J).all():
+            J0 = one(X[0])
+            if np.abs(J[0] - J0).max() <= 1e-12 * max(1.0, float(np.abs(J0).max())):
+                return J
+    return np.array([one(x) for x in X]).reshape(N, *shape)
+
+
+def transition_jacobians(model: NonlinearModel, X: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
+    r""":math:`F_i = \partial f/\partial x` en chaque ligne :math:`x_i` de ``X`` (N, n) : (N, n, n), ou
+    (n, n) si ``f_jacobian`` est une matrice constante.
+
+    Une jacobienne **fonction** d'un modèle vectorisé est d'abord appelée une fois sur la pile ``X`` :
+    son résultat est pris s'il a la forme (N, n, n), des valeurs finies, et si sa première ligne égale
+    l'appel sur ``X[0]`` seul ; sinon (et pour un modèle non vectorisé ou des différences centrées), un
+    appel vérifié par tirage (:meth:`NonlinearModel.transition_jacobian`)."""
+    n = model.n_state
+    return _stacked_jacobian(model, "f_jacobian", X, (u,), (n, n), lambda x: model.transition_jacobian(x, u))
+
+
+def observation_jacobians(model: NonlinearModel, X: np.ndarray) -> np.ndarray:
+    r""":math:`H_i = \partial h/\partial x` en chaque ligne :math:`x_i` de ``X`` (N, n) : (N, m, n), ou
+    (m, n) si ``h_jacobian`` est une matrice constante (même règle que :func:`transition_jacobians`)."""
+    return _stacked_jacobian(model, "h_jacobian", X, (), (model.n_obs, model.n_state), model.observation_jacobian)
+
+
+def process_noises(model: NonlinearModel, X: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
+    r""":math:`W_iQW_i^T` en chaque ligne de ``X`` (N, n) : (N, n, n), ou :math:`Q` (n, n) si le bruit est
+    additif ou :math:`W` constante."""
+    if model.f_noise_jacobian is None or not callable(model.f_noise_jacobian):
+        return model.process_noise(X[0], u)
+    return np.array([model.process_noise(x, u) for x in X])
+
+
+def measurement_noises(model: NonlinearModel, X: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:
+    r""":math:`V_iRV_i^T` en chaque ligne de ``X`` (N, n), restreinte aux composantes ``idx`` : (N, m, m),
+    ou :math:`R` (m, m) si le bruit est additif ou :math:`V` constante."""
+    if model.h_noise_jacobian is None or not callable(model.h_noise_jacobian):
+        R = model.measurement_noise(X[0])
+    else:
+        R = np.array([model.measurement_noise(x) for x in X])
+    return R if idx is None else R[..., idx[:, None], idx]
+
+
+def residuals(model: NonlinearModel, Y: np.ndarray, Y_hat: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:
+    r"""Résidus :math:`y_i - \hat y_i` d'une pile (N, m_k), composantes angulaires ramenées dans
+    :math:`(-\pi, \pi]` (``idx`` : composantes observées, comme :meth:`NonlinearModel.residual`)."""
+    d = np.asarray(Y - Y_hat, dtype=float)
+    if model.angle_indices:
+        angles = list(model.angle_indices) if idx is None else [j for j, i in enumerate(idx) if int(i) in model.angle_indices]
+        if angles:
+            d[..., angles] = wrap_angle(d[..., angles])
+    return d
+
+
+def predict_moments_many(model: NonlinearModel, X: np.ndarray, P: np.ndarray, u: np.ndarray | None):
+    r"""Prédiction de l'EKF sur ``N`` tirages : :math:`\hat X^- = f(\hat X)` (N, n),
+    :math:`P^-_i = F_iP_iF_i^T + W_iQW_i^T` (N, n, n)."""
+    F = transition_jacobians(model, X, u)
+    X_pred = model.transition_many(X, u)
+    P_pred = symmetrize(F @ P @ np.swapaxes(F, -1, -2) + process_noises(model, X, u))
+    return X_pred, P_pred
+
+
+def linearize_observations(model: NonlinearModel, X: np.ndarray, Y: np.ndarray, idx: np.ndarray | None):
+    r"""Pour chaque tirage : résidu :math:`y_i - h(x_i)` (N, m_k), jacobienne :math:`H_i` (N, m_k, n) ou
+    (m_k, n), en ``X`` (N, n), restreints aux composantes observées ``idx`` (``None`` : toutes)."""
+    h = model.observe_many(X)
+    H = observation_jacobians(model, X)
+    if idx is not None:
+        h, H = h[:, idx], H[..., idx, :]
+    return residuals(model, Y, h, idx), H
+
+
+def _ekf_correct_many(model, X_pred, P_pred, Y, idx, joseph, k):
+    nu, H = linearize_observations(model, X_pred, Y, idx)
+    R = measurement_noises(model, X_pred, idx)
+    X, P, K, S = correct_many(X_pred, P_pred, nu, H, R, joseph, f"correction par y[{k}]")
+    return X, P, K, nu, S
 
 
 # --------------------------------------------------------------------------- étapes publiques
@@ -141,6 +267,29 @@ def extended_kalman_filter(
     return run_filter(extended_family(joseph), model, y, x0, P0, u)
 
 
+def extended_kalman_filter_runs(
+    model: NonlinearModel, Y: Any, x0: Any, P0: Any, u: Any = None, joseph: bool = False
+) -> FilterRuns:
+    r"""Filtre de Kalman étendu sur ``N`` tirages indépendants du même modèle, tous à la fois
+    (:func:`~kalman_course.filters.engine.run_filter_runs`) : mêmes équations que
+    :func:`extended_kalman_filter`, appliquées à la pile des tirages (:math:`\hat X` (N, n), :math:`P`
+    (N, n, n)). Avec un modèle vectorisé, :math:`f` et :math:`h` sont appelées une fois par pas pour toute la
+    pile ; sinon une fois par tirage (même résultat, plus lent).
+
+    Paramètres
+    ----------
+    model : NonlinearModel
+    Y : (N, T, m), ou (N, T) si m = 1 — ``NaN`` : composante manquante (tirage par tirage).
+    x0 : (n,) commun ou (N, n) ; P0 : (n, n) commune ou (N, n, n).
+    u : (T, p) commune à tous les tirages, optionnelle.
+    joseph : forme de Joseph pour la covariance a posteriori.
+
+    Renvoie un :class:`~kalman_course.FilterRuns` : ``x`` (N, T, n), ``P`` (N, T, n, n)… ;
+    ``result.run(i)`` est égal à ``extended_kalman_filter(model, Y[i], …)`` aux arrondis près.
+    """
+    return run_filter_runs(extended_family(joseph), model, Y, x0, P0, u)
+
+
 def extended_family(joseph: bool = False) -> FilterFamily:
     r"""Les étapes de l'EKF pour le moteur (état interne :math:`(\hat x, P)`)."""
 
@@ -151,6 +300,13 @@ def extended_family(joseph: bool = False) -> FilterFamily:
         x, P, K, nu, S = _ekf_correct(model, *state, y, idx, joseph)
         return (x, P), Correction(K, nu, S)
 
+    def predict_many(model, state, u, k):
+        return predict_moments_many(model, *state, u)
+
+    def update_many(model, state, Y, idx, k):
+        X, P, K, nu, S = _ekf_correct_many(model, *state, Y, idx, joseph, k)
+        return (X, P), Correction(K, nu, S)
+
     return FilterFamily(
         name="filtre de Kalman étendu",
         model_type=NonlinearModel,
@@ -159,4 +315,7 @@ def extended_family(joseph: bool = False) -> FilterFamily:
         predict=predict_step,
         update=update_step,
         moments=gaussian_moments,
+        prior_many=gaussian_prior_many,
+        predict_many=predict_many,
+        update_many=update_many,
     )

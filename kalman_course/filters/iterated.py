@@ -3,6 +3,10 @@ r"""Filtre de Kalman étendu itéré : prédiction de l'EKF, correction de Gauss
 
 La boucle de Gauss–Newton est celle de :mod:`kalman_course.filters.iteration` (la même que l'EKF itéré
 sur SE(3) et que les variantes des notes), avec l'espace des vecteurs (:math:`\oplus = +`).
+
+:func:`iterated_extended_kalman_filter_runs` filtre ``N`` tirages à la fois (moteur en lot,
+:func:`~kalman_course.filters.iteration.gauss_newton_update_many`) : chaque tirage itère et s'arrête
+selon sa propre règle, comme s'il était seul.
 """
 
 from __future__ import annotations
@@ -14,10 +18,26 @@ import scipy.linalg
 
 from ..core.linalg import cholesky_factor
 from ..core.models import NonlinearModel
-from ..core.results import FilterResult
+from ..core.results import FilterResult, FilterRuns
 from ..core.validation import KalmanInputError, as_float_array, as_gaussian, as_vector, shape_text
-from .engine import Correction, FilterFamily, gaussian_moments, gaussian_prior, run_filter
-from .extended import NONLINEAR_HINT, check_model, linearize_observation, predict_moments
+from .engine import (
+    Correction,
+    FilterFamily,
+    gaussian_moments,
+    gaussian_prior,
+    gaussian_prior_many,
+    run_filter,
+    run_filter_runs,
+)
+from .extended import (
+    NONLINEAR_HINT,
+    check_model,
+    linearize_observation,
+    linearize_observations,
+    measurement_noises,
+    predict_moments,
+    predict_moments_many,
+)
 from .iteration import (
     DEFAULT_MAX_ITER,
     DEFAULT_TOL,
@@ -25,9 +45,18 @@ from .iteration import (
     IteratedCorrection,
     check_iterations,
     gauss_newton_update,
+    gauss_newton_update_many,
 )
 
-__all__ = ["IteratedUpdate", "iekf_update", "map_cost", "map_costs", "iterated_extended_kalman_filter", "iterated_family"]
+__all__ = [
+    "IteratedUpdate",
+    "iekf_update",
+    "map_cost",
+    "map_costs",
+    "iterated_extended_kalman_filter",
+    "iterated_extended_kalman_filter_runs",
+    "iterated_family",
+]
 
 
 class IteratedUpdate(NamedTuple):
@@ -159,6 +188,40 @@ def iterated_extended_kalman_filter(
     return run_filter(iterated_family(max_iter, tol, joseph), model, y, x0, P0, u)
 
 
+def iterated_extended_kalman_filter_runs(
+    model: NonlinearModel,
+    Y: Any,
+    x0: Any,
+    P0: Any,
+    u: Any = None,
+    max_iter: int = DEFAULT_MAX_ITER,
+    tol: float = DEFAULT_TOL,
+    joseph: bool = False,
+) -> FilterRuns:
+    r"""EKF itéré sur ``N`` tirages indépendants du même modèle, tous à la fois
+    (:func:`~kalman_course.filters.engine.run_filter_runs`).
+
+    Mêmes paramètres que :func:`~kalman_course.filters.extended.extended_kalman_filter_runs` (``Y``
+    (N, T, m), ``x0`` (n,) ou (N, n), ``P0`` (n, n) ou (N, n, n), ``u`` (T, p) commune), plus ``max_iter``
+    et ``tol``. À chaque pas, la correction de Gauss–Newton itère sur la pile des tirages ; chacun s'arrête
+    par la règle de :func:`iterated_extended_kalman_filter` (:math:`\lVert x^{(i+1)} - x^{(i)}\rVert \le`
+    ``tol`` ou ``max_iter`` itérations), les tirages arrêtés restant figés pendant que les autres itèrent.
+    ``result.n_iter`` (N, T) ; ``result.run(i)`` est égal à ``iterated_extended_kalman_filter(model, Y[i], …)``
+    aux arrondis près.
+    """
+    return run_filter_runs(iterated_family(max_iter, tol, joseph), model, Y, x0, P0, u)
+
+
+def _iterated_correct_many(model, X_pred, P_pred, Y, idx, joseph, max_iter, tol, k):
+    R = measurement_noises(model, X_pred, idx)  # évaluée en x̂⁻, comme pour un seul tirage
+
+    def linearize(X_a, runs):
+        r, H = linearize_observations(model, X_a, Y[runs], idx)
+        return r, H, (R if R.ndim == 2 else R[runs])
+
+    return gauss_newton_update_many(X_pred, P_pred, linearize, max_iter, tol, joseph, f"correction par y[{k}]")
+
+
 def _iterated_correct(model, x_pred, P_pred, y, idx, joseph, max_iter, tol) -> IteratedCorrection:
     R = model.measurement_noise(x_pred)
     if idx is not None:
@@ -182,6 +245,13 @@ def iterated_family(max_iter: int = DEFAULT_MAX_ITER, tol: float = DEFAULT_TOL, 
         c = _iterated_correct(model, *state, y, idx, joseph, max_iter, tol)
         return (c.x, c.P), Correction(c.K, c.innovation, c.S, c.n_iter)
 
+    def predict_many(model, state, u, k):
+        return predict_moments_many(model, *state, u)
+
+    def update_many(model, state, Y, idx, k):
+        c = _iterated_correct_many(model, *state, Y, idx, joseph, max_iter, tol, k)
+        return (c.x, c.P), Correction(c.K, c.innovation, c.S, c.n_iter)
+
     return FilterFamily(
         name="filtre de Kalman étendu itéré",
         model_type=NonlinearModel,
@@ -190,4 +260,7 @@ def iterated_family(max_iter: int = DEFAULT_MAX_ITER, tol: float = DEFAULT_TOL, 
         predict=predict_step,
         update=update_step,
         moments=gaussian_moments,
+        prior_many=gaussian_prior_many,
+        predict_many=predict_many,
+        update_many=update_many,
     )

@@ -20,6 +20,10 @@ point :math:`x_i`, avec :math:`\xi_i = x_i \ominus \hat x^-`, :math:`P_i = \math
 
 Pour un vecteur, c'est :math:`x^{(i+1)} = \hat x^- + K_i\,[y - h(x^{(i)}) - H_i(\hat x^- - x^{(i)})]`
 (Bell & Cathey, 1993).
+
+:func:`gauss_newton_update_many` fait la même boucle sur ``N`` tirages à la fois (espace des vecteurs) :
+chaque tirage s'arrête par **la même règle**, à sa propre itération ; un tirage arrêté est figé pendant que
+les autres itèrent, si bien que chacun est égal, aux arrondis près, à :func:`gauss_newton_update` seul.
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
-from ..core.linalg import correct, symmetrize
+from ..core.linalg import correct, correct_many, symmetrize
 from ..core.validation import KalmanInputError
 
 __all__ = [
@@ -42,6 +46,8 @@ __all__ = [
     "check_iterations",
     "iterate",
     "gauss_newton_update",
+    "IteratedCorrections",
+    "gauss_newton_update_many",
 ]
 
 #: Nombre maximal d'itérations par défaut.
@@ -170,3 +176,70 @@ def gauss_newton_update(
     if space.transport is not None:
         P_post = symmetrize(space.transport(P_post, delta))
     return IteratedCorrection(out.x, P_post, K, nu, S, out.iterates, np.array(steps), out.n_iter, out.converged)
+
+
+class IteratedCorrections(NamedTuple):
+    r"""Résultat de :func:`gauss_newton_update_many` : les champs de :class:`IteratedCorrection` (sans la
+    suite des itérés) avec un axe des tirages en tête — ``x`` (N, n), ``P`` (N, n, n), ``K`` (N, n, m),
+    ``innovation`` (N, m), ``S`` (N, m, m), ``n_iter`` (N,) entier, ``converged`` (N,) booléen."""
+
+    x: np.ndarray
+    P: np.ndarray
+    K: np.ndarray
+    innovation: np.ndarray
+    S: np.ndarray
+    n_iter: np.ndarray
+    converged: np.ndarray
+
+
+def gauss_newton_update_many(
+    X_pred: np.ndarray,
+    P_pred: np.ndarray,
+    linearize: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+    max_iter: int = DEFAULT_MAX_ITER,
+    tol: float = DEFAULT_TOL,
+    joseph: bool = False,
+    where: str = "",
+) -> IteratedCorrections:
+    r"""Correction itérée de Gauss–Newton sur ``N`` tirages à la fois (espace des vecteurs,
+    :math:`\oplus = +`) : pour chaque tirage :math:`j` encore actif, avec :math:`\xi_{j,i} = x_{j,i} - \hat x^-_j`,
+
+    .. math::
+
+        \nu_{j,i} = r_{j,i} + H_{j,i}\xi_{j,i},\quad K_{j,i} = P^-_jH_{j,i}^T(H_{j,i}P^-_jH_{j,i}^T + R_j)^{-1},\quad
+        \delta_{j,i} = -\xi_{j,i} + K_{j,i}\nu_{j,i},\quad x_{j,i+1} = x_{j,i} + \delta_{j,i} ;
+
+    le tirage :math:`j` s'arrête dès que :math:`\lVert\delta_{j,i}\rVert \le` ``tol`` (ou après ``max_iter``
+    itérations) : c'est la règle de :func:`iterate`, appliquée tirage par tirage ; les tirages arrêtés ne
+    sont plus linéarisés.
+
+    ``X_pred`` (N, n), ``P_pred`` (N, n, n) ; ``linearize(X_a, runs)`` reçoit les itérés (g, n) des tirages
+    encore actifs ``runs`` (indices dans 0…N−1) et renvoie :math:`(r, H, R)` : résidus (g, m), jacobiennes
+    (g, m, n) ou (m, n) commune, covariance de mesure (g, m, m) ou (m, m) commune. ``where`` nomme le pas
+    dans un message d'erreur. Renvoie :class:`IteratedCorrections`.
+    """
+    max_iter, tol = check_iterations(max_iter, tol)
+    N, n = X_pred.shape
+    X = np.array(X_pred, dtype=float)
+    n_iter = np.zeros(N, dtype=int)
+    converged = np.zeros(N, dtype=bool)
+    P_post = K = S = nu = None
+    active = np.arange(N)
+    for _ in range(max_iter):
+        X_a = X[active]
+        xi = X_a - X_pred[active]
+        r, H, R = linearize(X_a, active)
+        nu_a = r + (H @ xi[..., None])[..., 0]
+        delta, P_a, K_a, S_a = correct_many(-xi, P_pred[active], nu_a, H, R, joseph, where)
+        if P_post is None:
+            m = nu_a.shape[-1]
+            P_post, K, S, nu = np.empty((N, n, n)), np.empty((N, n, m)), np.empty((N, m, m)), np.empty((N, m))
+        X[active] = X_a + delta
+        P_post[active], K[active], S[active], nu[active] = P_a, K_a, S_a, nu_a
+        n_iter[active] += 1
+        done = np.linalg.norm(delta, axis=1) <= tol
+        converged[active[done]] = True
+        active = active[~done]
+        if active.size == 0:
+            break
+    return IteratedCorrections(X, P_post, K, nu, S, n_iter, converged)

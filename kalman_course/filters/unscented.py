@@ -33,6 +33,10 @@ C'est l'algorithme de ``filterpy.kalman.UnscentedKalmanFilter`` 2.0.0 (qui, lui 
 sigma de la loi prédite à la fin de ``predict``). Les composantes angulaires de la mesure
 (``model.angle_indices``) ont une moyenne circulaire :math:`\operatorname{atan2}(\sum W^m\sin, \sum W^m\cos)`
 et des écarts ramenés dans :math:`(-\pi, \pi]`.
+
+**Tirages en lot** (:func:`unscented_kalman_filter_runs`) : les mêmes formules sur ``N`` tirages à la fois ;
+les :math:`N(2n+1)` points sigma d'un pas passent par :math:`f` ou :math:`h` en **un** appel si le modèle
+est vectorisé (:meth:`~kalman_course.NonlinearModel.transition_many`), un appel par point sinon.
 """
 
 from __future__ import annotations
@@ -45,7 +49,7 @@ import scipy.linalg
 from ..core.angles import wrap_angle
 from ..core.linalg import symmetrize
 from ..core.models import NonlinearModel
-from ..core.results import FilterResult
+from ..core.results import FilterResult, FilterRuns
 from ..core.validation import (
     KalmanInputError,
     as_float_array,
@@ -54,8 +58,8 @@ from ..core.validation import (
     check_finite_output,
     check_pd,
 )
-from .engine import Correction, FilterFamily, run_filter
-from .extended import NONLINEAR_HINT
+from .engine import Correction, FilterFamily, gaussian_prior_many, run_filter, run_filter_runs
+from .extended import NONLINEAR_HINT, residuals
 
 __all__ = [
     "SigmaPoints",
@@ -64,6 +68,7 @@ __all__ = [
     "sigma_points",
     "unscented_transform",
     "unscented_kalman_filter",
+    "unscented_kalman_filter_runs",
     "unscented_family",
 ]
 
@@ -280,6 +285,68 @@ def _ukf_update(model, x_pred, P_pred, y, idx, Wm, Wc, scale, k):
     return x, P, K, nu, S
 
 
+# --------------------------------------------------------------------------- noyaux en lot
+
+
+def _points_many(X: np.ndarray, P: np.ndarray, scale: float, where: str, what: str) -> np.ndarray:
+    """Points sigma de ``N`` tirages (N, 2n+1, n) : pour le tirage ``i``, ``X[i]`` puis ``X[i]`` ± les
+    lignes du facteur de Cholesky supérieur :math:`U_i` de ``scale · P[i]`` (:math:`U_i = L_i^T`)."""
+    try:
+        L = np.linalg.cholesky(scale * P)
+    except np.linalg.LinAlgError:
+        for i in range(P.shape[0]):
+            _points(X[i], P[i], scale, f"tirage {i}, {where}", what)  # lève l'erreur du premier tirage fautif
+        raise KalmanInputError(
+            f"UKF, {where} : une covariance {what} n'est plus définie positive : la factorisation de Cholesky "
+            "des points sigma échoue. Essayez un α plus grand, κ ≥ 0, ou augmentez Q ou P0."
+        ) from None
+    U = np.swapaxes(L, -1, -2)
+    Xc = X[:, None, :]
+    return np.concatenate([Xc, Xc + U, Xc - U], axis=1)
+
+
+def _ukf_predict_many(model, X, P, u, Wm, Wc, scale, k):
+    n = X.shape[1]
+    pts = _points_many(X, P, scale, f"prédiction vers y[{k}]", "a posteriori P")
+    Xf = model.transition_many(pts.reshape(-1, n), u).reshape(pts.shape)
+    X_pred = Wm @ Xf                                   # (N, n)
+    D = Xf - X_pred[:, None, :]
+    P_pred = np.swapaxes(D, -1, -2) @ (Wc[:, None] * D) + model.Q
+    return X_pred, P_pred
+
+
+def _ukf_update_many(model, X_pred, P_pred, Y, idx, Wm, Wc, scale, k):
+    N, n = X_pred.shape
+    pts = _points_many(X_pred, P_pred, scale, f"correction par y[{k}]", "prédite P⁻")
+    Z = model.observe_many(pts.reshape(-1, n)).reshape(N, pts.shape[1], model.n_obs)
+    R = model.R
+    if idx is not None:
+        Z, R = Z[..., idx], R[np.ix_(idx, idx)]
+    angles = _observed_angles(model, idx)
+    y_hat = Wm @ Z                                     # (N, m_k)
+    if angles:
+        y_hat[:, angles] = np.arctan2(Wm @ np.sin(Z[..., angles]), Wm @ np.cos(Z[..., angles]))
+    dZ = Z - y_hat[:, None, :]
+    if angles:
+        dZ[..., angles] = wrap_angle(dZ[..., angles])
+    WdZ = Wc[:, None] * dZ
+    S = np.swapaxes(dZ, -1, -2) @ WdZ + R              # (N, m_k, m_k)
+    Pxy = np.swapaxes(pts - X_pred[:, None, :], -1, -2) @ WdZ  # (N, n, m_k)
+    try:
+        L = np.linalg.cholesky(S)
+    except np.linalg.LinAlgError:
+        bad = next(i for i in range(N) if np.any(np.linalg.eigvalsh(S[i]) <= 0))
+        raise KalmanInputError(
+            f"UKF, tirage {bad}, correction par y[{k}] : la covariance d'innovation S n'est pas définie positive "
+            "(des poids W^c négatifs peuvent la rendre indéfinie) : essayez un α plus grand ou κ ≥ 0."
+        ) from None
+    K = np.swapaxes(np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, np.swapaxes(Pxy, -1, -2))), -1, -2)
+    nu = residuals(model, Y, y_hat, idx)
+    X = X_pred + (K @ nu[..., None])[..., 0]
+    P = symmetrize(P_pred - K @ S @ np.swapaxes(K, -1, -2))
+    return X, P, K, nu, S
+
+
 # --------------------------------------------------------------------------- famille et boucle
 
 
@@ -318,6 +385,20 @@ def unscented_family(alpha: float, beta: float = 2.0, kappa: float = 0.0) -> Fil
         x, P, K, nu, S = _ukf_update(model, x_pred, P_pred, y, idx, Wm, Wc, scale, k)
         return (x, P, k), Correction(K, nu, S)
 
+    def prior_many(model, x0, P0, N):
+        _check_model(model)
+        _check_parameters(model.n_state, alpha, beta, kappa)
+        return gaussian_prior_many(model, x0, P0, N, definite=True)  # racines de Cholesky des P0
+
+    def predict_many(model, state, u, k):
+        Wm, Wc, scale = constants(model)
+        return _ukf_predict_many(model, *state, u, Wm, Wc, scale, k)
+
+    def update_many(model, state, Y, idx, k):
+        Wm, Wc, scale = constants(model)
+        X, P, K, nu, S = _ukf_update_many(model, *state, Y, idx, Wm, Wc, scale, k)
+        return (X, P), Correction(K, nu, S)
+
     return FilterFamily(
         name="filtre de Kalman sans parfum (UKF)",
         model_type=NonlinearModel,
@@ -326,6 +407,9 @@ def unscented_family(alpha: float, beta: float = 2.0, kappa: float = 0.0) -> Fil
         predict=predict_step,
         update=update_step,
         moments=lambda state: (state[0], state[1]),
+        prior_many=prior_many,
+        predict_many=predict_many,
+        update_many=update_many,
     )
 
 
@@ -361,3 +445,31 @@ def unscented_kalman_filter(
     :class:`~kalman_course.KalmanInputError` qui nomme l'étape et la mesure.
     """
     return run_filter(unscented_family(alpha, beta, kappa), model, y, x0, P0, u)
+
+
+def unscented_kalman_filter_runs(
+    model: NonlinearModel,
+    Y: Any,
+    x0: Any,
+    P0: Any,
+    u: Any = None,
+    *,
+    alpha: float,
+    beta: float = 2.0,
+    kappa: float,
+) -> FilterRuns:
+    r"""Filtre de Kalman sans parfum sur ``N`` tirages indépendants du même modèle, tous à la fois
+    (:func:`~kalman_course.filters.engine.run_filter_runs`) : les formules de :func:`unscented_kalman_filter`
+    appliquées à la pile des tirages ; les :math:`N(2n+1)` points sigma d'un pas passent par :math:`f` (ou
+    :math:`h`) en un appel si le modèle est vectorisé.
+
+    Paramètres : ``Y`` (N, T, m) (ou (N, T) si m = 1 ; ``NaN`` : composante manquante, tirage par tirage),
+    ``x0`` (n,) ou (N, n), ``P0`` (n, n) ou (N, n, n) définie(s) positive(s), ``u`` (T, p) commune ;
+    ``alpha``, ``beta``, ``kappa`` comme :func:`unscented_kalman_filter`.
+
+    Renvoie un :class:`~kalman_course.FilterRuns` (``x`` (N, T, n), ``P`` (N, T, n, n)…) ;
+    ``result.run(i)`` est égal à ``unscented_kalman_filter(model, Y[i], …)`` aux arrondis près. Une
+    covariance qui cesse d'être définie positive lève une :class:`~kalman_course.KalmanInputError` qui
+    nomme le tirage, l'étape et la mesure.
+    """
+    return run_filter_runs(unscented_family(alpha, beta, kappa), model, Y, x0, P0, u)

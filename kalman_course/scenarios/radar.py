@@ -77,13 +77,24 @@ def range_bearing(x: np.ndarray) -> np.ndarray:
 
 def range_bearing_jacobian(x: np.ndarray, n_state: int = 2) -> np.ndarray:
     r"""Jacobienne (2, n_state) de :func:`range_bearing` :
-    :math:`\begin{bmatrix} p_x/r & p_y/r \\ -p_y/r^2 & p_x/r^2 \end{bmatrix}` (colonnes nulles au-delà de la position)."""
-    px, py = x[0], x[1]
+    :math:`\begin{bmatrix} p_x/r & p_y/r \\ -p_y/r^2 & p_x/r^2 \end{bmatrix}` (colonnes nulles au-delà de la position).
+
+    Forme (2, n_state) pour un état, (N, 2, n_state) pour une pile d'états (N, n) (filtres en lot)."""
+    x = np.asarray(x)
+    if x.ndim == 1:  # un seul état : sans np.stack (appelée à chaque pas et à chaque itération des filtres)
+        px, py = x[0], x[1]
+        r2 = px * px + py * py
+        r = np.sqrt(r2)
+        H = np.zeros((2, n_state))
+        H[0, :2] = [px / r, py / r]
+        H[1, :2] = [-py / r2, px / r2]
+        return H
+    px, py = x[..., 0], x[..., 1]
     r2 = px * px + py * py
     r = np.sqrt(r2)
-    H = np.zeros((2, n_state))
-    H[0, :2] = [px / r, py / r]
-    H[1, :2] = [-py / r2, px / r2]
+    H = np.zeros((*x.shape[:-1], 2, n_state))
+    H[..., 0, 0], H[..., 0, 1] = px / r, py / r
+    H[..., 1, 0], H[..., 1, 1] = -py / r2, px / r2
     return H
 
 
