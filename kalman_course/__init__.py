@@ -27,8 +27,14 @@ from .diagnostics.consistency import (
     whitened_innovations,
     whiteness_test,
 )
-from .filters.extended import ekf_predict, ekf_update, extended_kalman_filter
-from .filters.iterated import IteratedUpdate, iekf_update, iterated_extended_kalman_filter, map_cost
+from .filters.extended import ekf_predict, ekf_update, extended_kalman_filter, extended_kalman_filter_runs
+from .filters.iterated import (
+    IteratedUpdate,
+    iekf_update,
+    iterated_extended_kalman_filter,
+    iterated_extended_kalman_filter_runs,
+    map_cost,
+)
 from .lecture.estimator import (
     MeanError,
     covariance_for_gain,
@@ -55,6 +61,7 @@ from .filters.unscented import (
     sigma_points,
     sigma_weights,
     unscented_kalman_filter,
+    unscented_kalman_filter_runs,
     unscented_transform,
 )
 from .filters.particle import (
@@ -162,7 +169,9 @@ __all__ = [
     "ekf_update",
     "iekf_update",
     "extended_kalman_filter",
+    "extended_kalman_filter_runs",
     "iterated_extended_kalman_filter",
+    "iterated_extended_kalman_filter_runs",
     "map_cost",
     "JacobianCheck",
     "check_jacobian",
@@ -175,6 +184,7 @@ __all__ = [
     "sigma_weights",
     "unscented_transform",
     "unscented_kalman_filter",
+    "unscented_kalman_filter_runs",
     "RESAMPLING_SCHEMES",
     "ParticleFilterResult",
     "effective_sample_size",

@@ -348,6 +348,8 @@ def _small_result():
         (lambda s, r: kc.nees(s.x[:-1], r), r"« x_true » doit être de forme \(30, 1\)"),
         (lambda s, r: kc.nees(np.full((30, 1), np.nan), r), r"« x_true » contient des valeurs non finies"),
         (lambda s, r: kc.nees(s.x, None), r"« result » doit être un FilterResult"),
+        (lambda s, r: kc.nees(s.x, kc.kalman_filter_runs(kc.scenarios.constant_voltage_model(), s.y[None], [0.0], [[1.0]])),
+         r"« result » doit être le résultat d'un seul tirage ; reçu un FilterRuns de 1 tirages"),
         (lambda s, r: kc.chi2_band(0), r"« dof » doit être un entier ≥ 1"),
         (lambda s, r: kc.chi2_band(2, 0), r"« n_values » doit être un entier ≥ 1"),
         (lambda s, r: kc.chi2_band(2, 10, 1.0), r"« level » doit être strictement entre 0 et 1"),

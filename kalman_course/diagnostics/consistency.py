@@ -27,7 +27,7 @@ import numpy as np
 import scipy.linalg
 import scipy.stats
 
-from ..core.results import FilterResult, freeze_fields
+from ..core.results import FilterResult, FilterRuns, freeze_fields
 from ..core.simulation import check_positive_int
 from ..tables import Table
 from ..core.validation import KalmanInputError, as_float_array, shape_text
@@ -60,6 +60,11 @@ def _check_result(result: Any, name: str = "result") -> FilterResult:
         raise KalmanInputError(
             f"« {name} » doit être un FilterResult (sortie de kalman_filter, extended_kalman_filter…) ; "
             f"reçu {type(result).__name__}."
+        )
+    if isinstance(result, FilterRuns):
+        raise KalmanInputError(
+            f"« {name} » doit être le résultat d'un seul tirage ; reçu un FilterRuns de {result.n_runs} tirages "
+            f"(prendre « {name}.run(i) », ou voir monte_carlo_consistency)."
         )
     return result
 
