@@ -83,6 +83,25 @@ def test_error_recursion_pathwise(conditions):
             np.testing.assert_allclose(e[k + 1], (I - K @ C) @ (A @ e[k] - phi[k]) + K @ psi[k], atol=1e-10)
 
 
+def test_linear_estimator_runs_is_the_kalman_filter_on_each_run():
+    rng = np.random.default_rng(7)
+    model = random_model(rng, 3, 2, 1)
+    u = rng.standard_normal((25, 1))
+    Y = np.stack([kc.simulate(model, np.zeros(3), 25, u, rng=s).y for s in range(4)])
+    x0, P0 = np.ones(3), 2.0 * np.eye(3)
+    K = kc.kalman_filter(model, Y[0], x0, P0, u).K  # les gains ne dépendent pas des mesures
+    est = kc.linear_estimator_runs(model, Y, x0, K, u=u)
+    assert est.shape == (4, 25, 3)
+    for i in range(4):
+        np.testing.assert_allclose(est[i], kc.kalman_filter(model, Y[i], x0, P0, u).x, atol=1e-12)
+    with pytest.raises(kc.KalmanInputError, match=r"« Y » doit être de forme \(N, T, 2\)"):
+        kc.linear_estimator_runs(model, Y[0], x0, K, u=u)
+    with pytest.raises(kc.KalmanInputError, match=r"« Y » contient des mesures manquantes"):
+        kc.linear_estimator_runs(model, np.full((2, 25, 2), np.nan), x0, K, u=u)
+    with pytest.raises(kc.KalmanInputError, match=r"« estimator » \(batch=True\) doit renvoyer .* \(5, 25, 3\)"):
+        kc.monte_carlo(model, lambda Y: Y, 25, 5, x0_mean=x0, x0_cov=P0, x0_hat=x0, rng=1, u=u, batch=True)
+
+
 def test_linear_estimator_with_conditions_is_the_kalman_filter_and_filterpy():
     rng = np.random.default_rng(6)
     model = random_model(rng, 3, 2, 1)
@@ -171,8 +190,8 @@ def test_joseph_covariance_monte_carlo():
     K = np.array([[10.0, 2.0], [-4.0, 15.0]])
     T, R = 15, 4000
     x0_hat, P0 = np.array([1.0, 0.5]), np.diag([4.0, 2.0])
-    mc = kc.monte_carlo(model, lambda y: kc.linear_estimator(model, y, x0_hat, K), T, R,
-                        x0_mean=x0_hat, x0_cov=P0, x0_hat=x0_hat, rng=13)
+    mc = kc.monte_carlo(model, lambda Y: kc.linear_estimator_runs(model, Y, x0_hat, K), T, R,
+                        x0_mean=x0_hat, x0_cov=P0, x0_hat=x0_hat, rng=13, batch=True)
     P = P0
     for _ in range(T):
         P = kc.covariance_for_gain(model, model.A @ P @ model.A.T + model.Q, K)

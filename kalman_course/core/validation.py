@@ -197,6 +197,20 @@ def as_measurements(name: str, y: Any, m: int) -> np.ndarray:
     return arr
 
 
+def as_batch_measurements(name: str, Y: Any, m: int) -> np.ndarray:
+    """Mesures de ``N`` tirages ``(N, T, m)`` ; ``(N, T)`` accepté si ``m = 1`` ; ``NaN`` : manquante."""
+    arr = as_float_array(name, Y, allow_nan=True)
+    if arr.ndim == 2 and m == 1:
+        arr = arr[:, :, None]
+    if arr.ndim != 3 or arr.shape[2] != m or arr.shape[0] == 0 or arr.shape[1] == 0:
+        extra = " ou (N, T)" if m == 1 else ""
+        raise KalmanInputError(
+            f"« {name} » doit être de forme (N, T, {m}){extra} : N ≥ 1 tirages de T ≥ 1 mesures ; "
+            f"reçu {shape_text(arr.shape)}."
+        )
+    return arr
+
+
 def as_controls(name: str, u: Any, n_steps: int, p: int) -> np.ndarray | None:
     """Commandes empilées ``(T, p)`` (``(T,)`` accepté si ``p = 1``), ou ``None`` sans commande.
 

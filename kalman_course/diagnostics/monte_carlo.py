@@ -112,6 +112,7 @@ def monte_carlo(
     rng: Any,
     u: Any = None,
     P0: Any = None,
+    batch: bool = False,
 ) -> MonteCarlo:
     r"""Expérience de Monte-Carlo : ``n_runs`` trajectoires indépendantes, chacune estimée.
 
@@ -122,7 +123,9 @@ def monte_carlo(
     * ``estimator=None`` : le filtre de Kalman de ``model`` parti de :math:`(\hat x_0, P_0)` (``x0_hat``,
       ``P0``), pour tous les tirages à la fois (:func:`~kalman_course.kalman_filter_runs`) ;
     * ``estimator`` fonction : ``estimator(y)`` doit renvoyer les estimations :math:`\hat x_1 \dots \hat x_T`
-      de forme (T, n) (tout autre estimateur, par exemple ``lambda y: linear_estimator(model, y, x0_hat, K)``).
+      de forme (T, n) (tout autre estimateur, par exemple ``lambda y: linear_estimator(model, y, x0_hat, K)``) ;
+      avec ``batch=True``, ``estimator(Y)`` reçoit les mesures de tous les tirages, (R, T, m), et renvoie
+      (R, T, n) (par exemple ``lambda Y: linear_estimator_runs(model, Y, x0_hat, K)``).
 
     ``x0_hat`` (n,) est l'estimation initiale de l'estimateur ; elle sert aussi à calculer :math:`e_0`.
     ``rng`` : graine entière ou ``numpy.random.Generator`` (obligatoire).
@@ -147,6 +150,13 @@ def monte_carlo(
     _, xs, ys = simulate_runs(model, x0s, n_runs, n_steps, U, gen)
     if estimator is None:
         xhs = kalman_filter_runs(model, ys, x0_hat_arr, P0, U).x
+    elif batch:
+        xhs = np.asarray(estimator(ys), dtype=float)
+        if xhs.shape != (n_runs, n_steps, n):
+            raise KalmanInputError(
+                f"« estimator » (batch=True) doit renvoyer un tableau de forme ({n_runs}, {n_steps}, {n}) ; "
+                f"reçu {xhs.shape}."
+            )
     else:
         xhs = np.empty((n_runs, n_steps, n))
         for r in range(n_runs):

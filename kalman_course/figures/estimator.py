@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..lecture.estimator import linear_estimator, mean_error_recursion
+from ..lecture.estimator import linear_estimator_runs, mean_error_recursion
 from ..core.models import LinearGaussianModel
 from ..scenarios.engine import ENGINE_DT, mean_error_experiment
 from ..diagnostics.monte_carlo import monte_carlo
@@ -49,10 +49,11 @@ def stability_experiment(K: float, n_steps: int = 20, n_runs: int = 400):
     model = LinearGaussianModel(**COUNTER_EXAMPLE)
     Kmat = np.array([[K]])
 
-    def estimator(y):
-        return linear_estimator(model, y, [1.0], Kmat)
+    def estimator(Y):
+        return linear_estimator_runs(model, Y, [1.0], Kmat)
 
-    mc = monte_carlo(model, estimator, n_steps, n_runs, x0_mean=[0.0], x0_cov=[[0.0]], x0_hat=[1.0], rng=3)
+    mc = monte_carlo(model, estimator, n_steps, n_runs, x0_mean=[0.0], x0_cov=[[0.0]], x0_hat=[1.0], rng=3,
+                     batch=True)
     rec = mean_error_recursion(model, Kmat, x0_mean=[0.0], x0_hat=[1.0], n_steps=n_steps)
     return mc, rec
 

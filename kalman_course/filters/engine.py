@@ -45,6 +45,7 @@ from ..core.results import FilterHistory, FilterResult, FilterRuns
 from ..core.simulation import as_generator
 from ..core.validation import (
     KalmanInputError,
+    as_batch_measurements,
     as_controls,
     as_float_array,
     as_gaussian,
@@ -234,19 +235,6 @@ def run_filter(
 
 
 
-def _batch_measurements(Y: Any, m: int) -> np.ndarray:
-    """Mesures de ``N`` tirages ``(N, T, m)`` ; ``(N, T)`` accepté si ``m = 1`` ; ``NaN`` : manquante."""
-    arr = as_float_array("Y", Y, allow_nan=True)
-    if arr.ndim == 2 and m == 1:
-        arr = arr[:, :, None]
-    if arr.ndim != 3 or arr.shape[2] != m or arr.shape[0] == 0 or arr.shape[1] == 0:
-        extra = " ou (N, T)" if m == 1 else ""
-        raise KalmanInputError(
-            f"« Y » doit être de forme (N, T, {m}){extra} : N ≥ 1 tirages de T ≥ 1 mesures ; reçu {shape_text(arr.shape)}."
-        )
-    return arr
-
-
 def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, u: Any = None) -> FilterRuns:
     r"""Applique la famille ``family`` à ``N`` tirages indépendants du même modèle, tous à la fois : à
     chaque pas, une prédiction puis une correction sur la pile des tirages (axe des tirages en tête).
@@ -277,7 +265,7 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
             f"Le {family.name} n'a pas de mode en lot : filtrez les tirages un par un (boucle sur run_filter)."
         )
     m = model.n_obs
-    Yarr = _batch_measurements(Y, m)
+    Yarr = as_batch_measurements("Y", Y, m)
     N, T, _ = Yarr.shape
     if u is not None and np.ndim(u) == 3:
         raise KalmanInputError(

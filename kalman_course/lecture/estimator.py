@@ -30,6 +30,7 @@ import scipy.linalg
 from ..core.models import LinearGaussianModel
 from ..core.validation import (
     KalmanInputError,
+    as_batch_measurements,
     as_controls,
     as_float_array,
     as_matrix,
@@ -47,6 +48,7 @@ __all__ = [
     "filter_matrices",
     "gains_sequence",
     "linear_estimator",
+    "linear_estimator_runs",
     "mean_error_recursion",
     "measurement_initialisation",
     "spectral_radius",
@@ -158,20 +160,44 @@ def linear_estimator(
     matrices par défaut, c'est exactement le filtre de Kalman.
     """
     model = _check_model(model)
-    Y = as_measurements("y", y, model.n_obs)
+    return _estimate(model, as_measurements("y", y, model.n_obs)[None], "y", x0_hat, K, u, A_f, B_f)[0]
+
+
+def linear_estimator_runs(
+    model: LinearGaussianModel,
+    Y: Any,
+    x0_hat: Any,
+    K: Any,
+    *,
+    u: Any = None,
+    A_f: Any = None,
+    B_f: Any = None,
+) -> np.ndarray:
+    r""":func:`linear_estimator` appliqué à ``N`` tirages à la fois (même modèle, mêmes gains, mêmes
+    commandes) : la même récurrence, sur la pile des estimations (axe des tirages en tête).
+
+    ``Y`` : (N, T, m), ou (N, T) si m = 1. Renvoie (N, T, n) ; la ligne ``i`` est
+    ``linear_estimator(model, Y[i], …)``.
+    """
+    model = _check_model(model)
+    return _estimate(model, as_batch_measurements("Y", Y, model.n_obs), "Y", x0_hat, K, u, A_f, B_f)
+
+
+def _estimate(model, Y, name, x0_hat, K, u, A_f, B_f) -> np.ndarray:
+    r"""La récurrence :math:`\hat x_{n+1} = A_f\hat x_n + B_f u_n + K_{n+1}y_{n+1}` sur ``Y`` (N, T, m) → (N, T, n)."""
     if np.isnan(Y).any():
-        raise KalmanInputError("« y » contient des mesures manquantes (NaN) : l'estimateur linéaire les refuse.")
-    T = Y.shape[0]
-    x = as_vector("x0_hat", x0_hat, model.n_state)
+        raise KalmanInputError(f"« {name} » contient des mesures manquantes (NaN) : l'estimateur linéaire les refuse.")
+    N, T, _ = Y.shape
+    x = np.broadcast_to(as_vector("x0_hat", x0_hat, model.n_state), (N, model.n_state))
     U = as_controls("u", u, T, model.n_control)
     Ks = gains_sequence(model, K, T)
     A_fs, B_fs = _estimator_matrices(model, Ks, A_f, B_f)
-    out = np.empty((T, model.n_state))
+    out = np.empty((N, T, model.n_state))
     for k in range(T):
-        x = A_fs[k] @ x + Ks[k] @ Y[k]
+        x = x @ A_fs[k].T + Y[:, k] @ Ks[k].T
         if U is not None:
             x = x + B_fs[k] @ U[k]
-        out[k] = x
+        out[:, k] = x
     return out
 
 

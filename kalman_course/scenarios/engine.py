@@ -26,7 +26,7 @@ from ..core.models import LinearGaussianModel
 from ..core.simulation import Simulation, simulate
 from ..diagnostics.monte_carlo import ConsistencyRuns, MonteCarlo, monte_carlo, monte_carlo_consistency
 from ..filters.kalman import kalman_filter
-from ..lecture.estimator import MeanError, linear_estimator, mean_error_recursion
+from ..lecture.estimator import MeanError, linear_estimator_runs, mean_error_recursion
 from ..core.results import FilterResult
 
 __all__ = [
@@ -141,12 +141,12 @@ def mean_error_experiment(forget_command: bool, n_steps: int = MEAN_ERROR_STEPS,
     K = engine_kalman_gains(n_steps)
     B_f = np.zeros((2, 1)) if forget_command else None
 
-    def estimator(y):
-        return linear_estimator(model, y, ENGINE_X0_HAT, K, u=u, B_f=B_f)
+    def estimator(Y):
+        return linear_estimator_runs(model, Y, ENGINE_X0_HAT, K, u=u, B_f=B_f)
 
     mc = monte_carlo(
         model, estimator, n_steps, n_runs,
-        x0_mean=ENGINE_X0_MEAN, x0_cov=ENGINE_X0_COV, x0_hat=ENGINE_X0_HAT, rng=ENGINE_SEED, u=u,
+        x0_mean=ENGINE_X0_MEAN, x0_cov=ENGINE_X0_COV, x0_hat=ENGINE_X0_HAT, rng=ENGINE_SEED, u=u, batch=True,
     )
     rec = mean_error_recursion(model, K, x0_mean=ENGINE_X0_MEAN, x0_hat=ENGINE_X0_HAT, u=u, B_f=B_f)
     return mc, rec
