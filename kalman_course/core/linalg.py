@@ -25,8 +25,14 @@ S_NOT_PD = (
 
 
 def symmetrize(P: np.ndarray) -> np.ndarray:
-    """Partie symétrique :math:`(P + P^T)/2` (efface l'asymétrie due aux arrondis) ; ``P`` (…, n, n)."""
-    P = P + np.swapaxes(P, -1, -2).copy()
+    """Partie symétrique :math:`(P + P^T)/2` (efface l'asymétrie due aux arrondis) ; ``P`` (…, n, n).
+
+    Renvoie toujours un nouveau tableau. Une matrice 1 × 1 est symétrique : c'en est une simple copie
+    (mêmes valeurs que :math:`(p + p)/2`, calculée sans les deux opérations : les filtres scalaires, comme
+    le niveau local du Nil, l'appellent à chaque pas)."""
+    if P.shape[-1] == 1:
+        return P.copy()
+    P = P + P.swapaxes(-1, -2)
     P *= 0.5
     return P
 
