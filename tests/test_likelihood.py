@@ -30,6 +30,29 @@ def _local_level(theta):
 # --------------------------------------------------------------------------- statsmodels
 
 
+def test_nile_series_is_the_statsmodels_dataset():
+    """Le fichier lu directement redonne la série de ``statsmodels.datasets.nile.load()`` (pandas)."""
+    from statsmodels.datasets import nile as sm_nile
+
+    data = sm_nile.load().data
+    series = kc.datasets.nile()
+    np.testing.assert_array_equal(series.year, np.asarray(data["year"], dtype=float).astype(int))
+    np.testing.assert_array_equal(series.flow, np.asarray(data["volume"], dtype=float))
+
+
+def test_nile_series_loads_without_pandas():
+    """Cent nombres ne valent pas l'import de pandas et de statsmodels (≈ 0,4 s au premier appel)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, kalman_course as kc; s = kc.datasets.nile(True); "
+            "assert s.flow.shape == (100,) and int(s.missing.sum()) == 40; "
+            "print('pandas' in sys.modules, 'statsmodels' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "False"]
+
+
+
 @pytest.mark.parametrize("trend,params,expected", [
     ("llevel", NILE_LLEVEL, -633.46456365),  # valeurs mesurées avec statsmodels 0.15.0
     ("lltrend", NILE_LLTREND, -632.70137553),
