@@ -149,9 +149,12 @@ def rts_pass(x: np.ndarray, P: np.ndarray, x_pred: np.ndarray, P_pred: np.ndarra
     xs_rev, Ps_rev = [x_next], [P_next]
     # lignes k = T-2 … 0 : (x_k, P_k, G_k, x⁻_{k+1}, P⁻_{k+1})
     rows = zip(list(x[-2::-1]), list(P[-2::-1]), list(G[-2::-1]), list(x_pred[:0:-1]), list(P_pred[:0:-1]))
+    scalar = P.shape[-1] == 1  # une covariance 1 × 1 est symétrique : rien à symétriser
     for xk, Pk, Gk, xp_next, Pp_next in rows:
         x_next = xk + Gk.dot(x_next - xp_next)
-        P_next = symmetrize(Pk + Gk.dot(P_next - Pp_next).dot(Gk.T))  # symétrisation (arrondis)
+        P_next = Pk + Gk.dot(P_next - Pp_next).dot(Gk.T)
+        if not scalar:
+            P_next = symmetrize(P_next)  # symétrisation (arrondis)
         xs_rev.append(x_next)
         Ps_rev.append(P_next)
     xs = np.array(xs_rev[::-1]).reshape(x.shape)
