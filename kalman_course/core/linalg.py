@@ -13,7 +13,8 @@ import scipy.linalg
 
 from .validation import KalmanInputError
 
-__all__ = ["symmetrize", "kalman_gain", "correct", "cholesky_factor", "covariance_factor"]
+__all__ = ["symmetrize", "kalman_gain", "correct", "cholesky_factor", "covariance_factor", "centred_rows",
+           "weighted_rows"]
 
 _posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
 
@@ -86,3 +87,31 @@ def covariance_factor(M: np.ndarray) -> np.ndarray:
     donc valable aussi pour une covariance singulière, par exemple :math:`Q = 0`)."""
     lam, V = scipy.linalg.eigh(M)
     return V * np.sqrt(np.clip(lam, 0.0, None))
+
+
+#: Au plus autant de colonnes, les opérations « par ligne » d'un nuage (N, n) ∘ (n,) se font colonne par
+#: colonne : numpy diffuse mal un vecteur court sur beaucoup de lignes (boucle interne de longueur n, ≈ 5×
+#: plus lente), alors qu'une colonne est un seul tableau de N valeurs. Mêmes opérations, mêmes valeurs.
+COLUMNWISE_MAX = 16
+
+
+def centred_rows(X: np.ndarray, x: np.ndarray) -> np.ndarray:
+    r"""Écarts :math:`x^i - \hat x` des lignes d'un nuage : ``X`` (N, n), ``x`` (n,) ; renvoie (N, n)
+    (la même chose que ``X - x``, calculée colonne par colonne si :math:`n \le` :data:`COLUMNWISE_MAX`)."""
+    if X.shape[1] > COLUMNWISE_MAX:
+        return X - x
+    D = np.empty_like(X)
+    for j in range(X.shape[1]):
+        np.subtract(X[:, j], x[j], out=D[:, j])
+    return D
+
+
+def weighted_rows(w: np.ndarray, D: np.ndarray) -> np.ndarray:
+    r"""Lignes pondérées :math:`w^i d^i` : ``w`` (N,), ``D`` (N, n) ; renvoie (N, n) (la même chose que
+    ``w[:, None] * D``, colonne par colonne si :math:`n \le` :data:`COLUMNWISE_MAX`)."""
+    if D.shape[1] > COLUMNWISE_MAX:
+        return w[:, None] * D
+    out = np.empty_like(D)
+    for j in range(D.shape[1]):
+        np.multiply(w, D[:, j], out=out[:, j])
+    return out

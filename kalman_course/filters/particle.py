@@ -33,7 +33,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.angles import wrap_angle
-from ..core.linalg import covariance_factor, symmetrize
+from ..core.linalg import centred_rows, covariance_factor, symmetrize, weighted_rows
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult
 from ..core.simulation import as_generator, check_positive_int
@@ -308,47 +308,21 @@ def _log_likelihoods(model: NonlinearModel, HX: np.ndarray, y: np.ndarray, white
     return -0.5 * maha - white.half_m_log_2pi - white.log_diag
 
 
-#: Au plus autant de colonnes, les opérations « par ligne » (N, n) ∘ (n,) se font colonne par colonne :
-#: numpy diffuse mal un vecteur court sur beaucoup de lignes (boucle interne de longueur n), alors qu'une
-#: colonne est un seul tableau de N valeurs. Mêmes opérations, mêmes valeurs.
-_COLUMNWISE = 16
-
-
-def _centred(X: np.ndarray, x: np.ndarray) -> np.ndarray:
-    r"""Écarts :math:`x^i - \hat x` (N, n), ``X`` (N, n), ``x`` (n,)."""
-    if X.shape[1] > _COLUMNWISE:
-        return X - x
-    D = np.empty_like(X)
-    for j in range(X.shape[1]):
-        np.subtract(X[:, j], x[j], out=D[:, j])
-    return D
-
-
-def _weighted_rows(w: np.ndarray, D: np.ndarray) -> np.ndarray:
-    r"""Lignes pondérées :math:`w^i d^i` (N, n), ``w`` (N,), ``D`` (N, n)."""
-    if D.shape[1] > _COLUMNWISE:
-        return w[:, None] * D
-    out = np.empty_like(D)
-    for j in range(D.shape[1]):
-        np.multiply(w, D[:, j], out=out[:, j])
-    return out
-
-
 def _weighted_moments(X: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     r"""Moyenne et covariance pondérées :math:`\hat x = \sum_i w^ix^i`,
     :math:`P = \sum_i w^i(x^i - \hat x)(x^i - \hat x)^T`, et les poids fois les écarts
     :math:`w^i(x^i - \hat x)` (N, n), qui resservent à la covariance croisée."""
     x = w.dot(X)
-    D = _centred(X, x)
-    WD = _weighted_rows(w, D)
+    D = centred_rows(X, x)
+    WD = weighted_rows(w, D)
     return x, symmetrize(D.T.dot(WD)), WD
 
 
 def _cloud_moments(X: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     r""":math:`(\hat x, P, X - \hat x)` du nuage ``X`` (N, n) de poids ``w`` (N,)."""
     x = w.dot(X)
-    D = _centred(X, x)
-    return x, symmetrize(D.T.dot(_weighted_rows(w, D))), D
+    D = centred_rows(X, x)
+    return x, symmetrize(D.T.dot(weighted_rows(w, D))), D
 
 
 def particle_family(
