@@ -62,7 +62,7 @@ from .filters.diffuse import (
 )
 from .filters.engine import run_filter
 from .filters.kalman import kalman_filter
-from .filters.smoothers import rts_smoother
+from .filters.smoothers import diffuse_rts_pass, rts_smoother
 
 __all__ = [
     "log_likelihood_terms",
@@ -544,21 +544,34 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
     :math:`M(e_oe_o^T + C_oPC_o^T)M^T + \operatorname{diag}(0, R_{mm} - R_{mo}R_{oo}^{-1}R_{om})`,
     :math:`M = [I;\ R_{mo}R_{oo}^{-1}]` (Shumway & Stoffer).
 
+    Au départ diffus, l'étape E ne passe que par le filtre augmenté (:func:`diffuse_family` dans le
+    moteur), l'information :math:`J_T`, :math:`h_T` et le lissage exact
+    (:func:`~kalman_course.filters.smoothers.diffuse_rts_pass`) : ni estimations exactes du filtre, ni
+    gains du lisseur exact, ni vérification « ce résultat vient de ce modèle » (l'étape filtre elle-même) ;
+    mêmes valeurs que :func:`diffuse_kalman_filter` suivi de :func:`rts_smoother`.
+
     Renvoie ``(log L du modèle donné, nouveau modèle)``.
     """
-    res = _filter(model, Y, x0, P0, U)
-    ll = filter_log_likelihood(res)
-    sm = rts_smoother(model, res, x0, P0)
+    if _prior(x0, P0):
+        res = kalman_filter(model, Y, x0, P0, U)
+        ll = filter_log_likelihood(res)
+        sm = rts_smoother(model, res, x0, P0)
+        xs, Ps, lag, x_initial, P_initial = sm.x, sm.P, sm.P_lag, sm.x_initial, sm.P_initial
+    else:
+        augmented = run_filter(diffuse_family(), model, Y, None, None, U)
+        J, h = diffuse_information(model, augmented)
+        ll = _diffuse_value(augmented, J[-1], h[-1])  # vérifie que J_T est inversible
+        xs, Ps, lag = diffuse_rts_pass(model.A, augmented, J[-1], h[-1])
+        x_initial = P_initial = None
     A, C, R = model.A, model.C, model.R
     T, m = Y.shape
-    xs, Ps, lag = sm.x, sm.P, sm.P_lag
     Bu = np.zeros_like(xs) if U is None else U @ model.B.T
     # transitions k-1 → k, k = 1…T-1 (et 0 depuis l'état initial si l'a priori est connu)
     prev_x, prev_P = xs[:-1], Ps[:-1]
     cur_x, cur_P, cur_lag, cur_Bu = xs[1:], Ps[1:], lag[1:], Bu[1:]
-    if sm.x_initial is not None:
-        prev_x = np.concatenate([sm.x_initial[None], prev_x])
-        prev_P = np.concatenate([sm.P_initial[None], prev_P])
+    if x_initial is not None:
+        prev_x = np.concatenate([x_initial[None], prev_x])
+        prev_P = np.concatenate([P_initial[None], prev_P])
         cur_x, cur_P, cur_lag, cur_Bu = xs, Ps, lag, Bu
     if cur_x.shape[0] == 0:
         raise KalmanInputError("Il faut au moins deux pas de mesure pour estimer Q par EM sans a priori.")

@@ -30,6 +30,29 @@ def _local_level(theta):
 # --------------------------------------------------------------------------- statsmodels
 
 
+def test_nile_series_is_the_statsmodels_dataset():
+    """Le fichier lu directement redonne la série de ``statsmodels.datasets.nile.load()`` (pandas)."""
+    from statsmodels.datasets import nile as sm_nile
+
+    data = sm_nile.load().data
+    series = kc.datasets.nile()
+    np.testing.assert_array_equal(series.year, np.asarray(data["year"], dtype=float).astype(int))
+    np.testing.assert_array_equal(series.flow, np.asarray(data["volume"], dtype=float))
+
+
+def test_nile_series_loads_without_pandas():
+    """Cent nombres ne valent pas l'import de pandas et de statsmodels (≈ 0,4 s au premier appel)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, kalman_course as kc; s = kc.datasets.nile(True); "
+            "assert s.flow.shape == (100,) and int(s.missing.sum()) == 40; "
+            "print('pandas' in sys.modules, 'statsmodels' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "False"]
+
+
+
 @pytest.mark.parametrize("trend,params,expected", [
     ("llevel", NILE_LLEVEL, -633.46456365),  # valeurs mesurées avec statsmodels 0.15.0
     ("lltrend", NILE_LLTREND, -632.70137553),
@@ -400,3 +423,29 @@ def test_import_kalman_course_does_not_import_statsmodels():
     code = "import sys, kalman_course; print('statsmodels' in sys.modules, 'pandas' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
+
+
+@pytest.mark.parametrize("missing", [False, True])
+def test_em_fast_e_step_equals_the_public_filter_and_smoother(missing):
+    """L'étape E d'EM (filtre augmenté, information et lissage exact sans vérifications) redonne ce que
+    donnent diffuse_kalman_filter, filter_log_likelihood et rts_smoother, et l'étape M qui en découle."""
+    from kalman_course.filters.smoothers import diffuse_rts_pass
+    from kalman_course.likelihood import em_step
+
+    y = kc.datasets.nile(missing=missing).flow
+    model = kc.LinearGaussianModel(1.0, 1.0, 2000.0, 9000.0)
+    res = kc.diffuse_kalman_filter(model, y)
+    sm = kc.rts_smoother(model, res)
+    xs, Ps, lag = diffuse_rts_pass(model.A, res.augmented, res.information[-1], res.information_vector[-1])
+    np.testing.assert_allclose(xs, sm.x, rtol=1e-12)
+    np.testing.assert_allclose(Ps, sm.P, rtol=1e-12)
+    np.testing.assert_allclose(lag[1:], sm.P_lag[1:], rtol=1e-12)
+    ll, new = em_step(model, y[:, None], None, None, None)
+    assert ll == pytest.approx(kc.filter_log_likelihood(res), abs=1e-9)
+    # étape M à la main, depuis le lisseur public (mesures complètes seulement)
+    if not missing:
+        r = sm.x[1:, 0] - sm.x[:-1, 0]
+        Q_ref = np.mean(r**2 + sm.P[1:, 0, 0] - 2 * sm.P_lag[1:, 0, 0] + sm.P[:-1, 0, 0])
+        R_ref = np.mean((y - sm.x[:, 0]) ** 2 + sm.P[:, 0, 0])
+        assert new.Q[0, 0] == pytest.approx(Q_ref, rel=1e-10)
+        assert new.R[0, 0] == pytest.approx(R_ref, rel=1e-10)

@@ -15,6 +15,7 @@ from .validation import KalmanInputError
 
 __all__ = [
     "symmetrize", "kalman_gain", "correct", "solve_pd_many", "correct_many", "cholesky_factor", "covariance_factor",
+    "centred_rows", "weighted_rows",
 ]
 
 _posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
@@ -27,8 +28,14 @@ S_NOT_PD = (
 
 
 def symmetrize(P: np.ndarray) -> np.ndarray:
-    """Partie symétrique :math:`(P + P^T)/2` (efface l'asymétrie due aux arrondis) ; ``P`` (…, n, n)."""
-    P = P + np.swapaxes(P, -1, -2).copy()
+    """Partie symétrique :math:`(P + P^T)/2` (efface l'asymétrie due aux arrondis) ; ``P`` (…, n, n).
+
+    Renvoie toujours un nouveau tableau. Une matrice 1 × 1 est symétrique : c'en est une simple copie
+    (mêmes valeurs que :math:`(p + p)/2`, calculée sans les deux opérations : les filtres scalaires, comme
+    le niveau local du Nil, l'appellent à chaque pas)."""
+    if P.shape[-1] == 1:
+        return P.copy()
+    P = P + P.swapaxes(-1, -2)
     P *= 0.5
     return P
 
@@ -132,3 +139,31 @@ def covariance_factor(M: np.ndarray) -> np.ndarray:
     donc valable aussi pour une covariance singulière, par exemple :math:`Q = 0`)."""
     lam, V = scipy.linalg.eigh(M)
     return V * np.sqrt(np.clip(lam, 0.0, None))
+
+
+#: Au plus autant de colonnes, les opérations « par ligne » d'un nuage (N, n) ∘ (n,) se font colonne par
+#: colonne : numpy diffuse mal un vecteur court sur beaucoup de lignes (boucle interne de longueur n, ≈ 5×
+#: plus lente), alors qu'une colonne est un seul tableau de N valeurs. Mêmes opérations, mêmes valeurs.
+COLUMNWISE_MAX = 16
+
+
+def centred_rows(X: np.ndarray, x: np.ndarray) -> np.ndarray:
+    r"""Écarts :math:`x^i - \hat x` des lignes d'un nuage : ``X`` (N, n), ``x`` (n,) ; renvoie (N, n)
+    (la même chose que ``X - x``, calculée colonne par colonne si :math:`n \le` :data:`COLUMNWISE_MAX`)."""
+    if X.shape[1] > COLUMNWISE_MAX:
+        return X - x
+    D = np.empty_like(X)
+    for j in range(X.shape[1]):
+        np.subtract(X[:, j], x[j], out=D[:, j])
+    return D
+
+
+def weighted_rows(w: np.ndarray, D: np.ndarray) -> np.ndarray:
+    r"""Lignes pondérées :math:`w^i d^i` : ``w`` (N,), ``D`` (N, n) ; renvoie (N, n) (la même chose que
+    ``w[:, None] * D``, colonne par colonne si :math:`n \le` :data:`COLUMNWISE_MAX`)."""
+    if D.shape[1] > COLUMNWISE_MAX:
+        return w[:, None] * D
+    out = np.empty_like(D)
+    for j in range(D.shape[1]):
+        np.multiply(w, D[:, j], out=out[:, j])
+    return out

@@ -13,8 +13,10 @@ pour montrer que le filtre et le lisseur les traversent sans rien changer à leu
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
@@ -57,13 +59,34 @@ class AnnualSeries:
                 f"{int(self.missing.sum())} manquantes>")
 
 
+def _csv_path() -> Path | None:
+    """Le fichier ``nile.csv`` livré avec statsmodels, trouvé sans importer statsmodels (ni pandas)."""
+    spec = importlib.util.find_spec("statsmodels")  # ne fait que chercher le paquet, sans l'exécuter
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    path = Path(next(iter(spec.submodule_search_locations))) / "datasets" / "nile" / "nile.csv"
+    return path if path.is_file() else None
+
+
 @lru_cache(maxsize=1)
 def _load() -> tuple[np.ndarray, np.ndarray]:
-    from statsmodels.datasets import nile as sm_nile  # importé ici : statsmodels ne charge qu'à l'usage
+    r"""Années et débits. Le fichier de statsmodels (colonnes ``year,volume``) est lu directement : importer
+    ``statsmodels.datasets`` chargerait pandas et statsmodels (≈ 0,4 s) pour cent nombres. Si le fichier
+    n'est pas à sa place, on passe par ``statsmodels.datasets.nile.load()``."""
+    path = _csv_path()
+    if path is not None:
+        with open(path, encoding="utf-8") as handle:
+            header = handle.readline().strip().split(",")
+            table = np.loadtxt(handle, delimiter=",", dtype=float, ndmin=2)
+        if header[:2] != ["year", "volume"]:
+            raise RuntimeError(f"{path} n'a pas les colonnes attendues (year, volume) : {header}.")
+        year, flow = table[:, 0], table[:, 1]
+    else:
+        from statsmodels.datasets import nile as sm_nile  # importé ici : statsmodels ne charge qu'à l'usage
 
-    data = sm_nile.load().data
-    year = np.asarray(data["year"], dtype=float)
-    flow = np.asarray(data["volume"], dtype=float)
+        data = sm_nile.load().data
+        year = np.asarray(data["year"], dtype=float)
+        flow = np.asarray(data["volume"], dtype=float)
     if year.shape != (100,) or not np.array_equal(year, np.arange(1871, 1971)):
         raise RuntimeError("Les données du Nil de statsmodels n'ont pas la forme attendue (1871–1970).")
     return year.astype(int), flow

@@ -51,7 +51,7 @@ import numpy as np
 from ..core.linalg import correct, symmetrize
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult, freeze
-from .engine import Correction, FilterFamily, run_filter
+from .engine import Correction, FilterFamily, gaussian_moments, run_filter
 
 __all__ = ["DIFFUSE_RTOL", "DiffuseFilterResult", "diffuse_family", "diffuse_kalman_filter", "is_determined"]
 
@@ -77,16 +77,17 @@ def diffuse_family() -> FilterFamily:
         return None  # avant la première mesure : aucune information
 
     def predict_step(model: LinearGaussianModel, state, u):
-        n = model.n_state
         if state is None:
+            n = model.n_state
             xa = np.zeros((n, n + 1))
             xa[:, 1:] = np.eye(n)
             return xa, np.zeros((n, n))
         xa, P = state
-        xa_pred = model.A.dot(xa)
+        A = model.A
+        xa_pred = A.dot(xa)
         if u is not None:
             xa_pred[:, 0] += model.B.dot(u)
-        return xa_pred, symmetrize(model.A.dot(P).dot(model.A.T) + model.Q)
+        return xa_pred, symmetrize(A.dot(P).dot(A.T) + model.Q)
 
     def update_step(model: LinearGaussianModel, state, y, idx):
         xa_pred, P_pred = state
@@ -107,7 +108,7 @@ def diffuse_family() -> FilterFamily:
         prior=prior,
         predict=predict_step,
         update=update_step,
-        moments=lambda state: state,
+        moments=gaussian_moments,  # l'état est déjà ([a | X], P) : le moteur le range tel quel
         state_shape=lambda model: (model.n_state, model.n_state + 1),
     )
 

@@ -32,7 +32,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.angles import wrap_angle
-from ..core.linalg import covariance_factor, symmetrize
+from ..core.linalg import centred_rows, covariance_factor, symmetrize
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult
 from ..core.simulation import check_positive_int
@@ -55,16 +55,24 @@ class EnsembleFilterResult(FilterResult):
 
 
 class EnsembleState(NamedTuple):
-    """État interne : ``X`` (N, n) les membres ; ``k`` l'indice de la mesure visée (messages d'erreur)."""
+    r"""État interne : ``X`` (N, n) les membres ; ``k`` l'indice de la mesure visée (messages d'erreur) ;
+    ``LQ`` (n, n), ``LR`` (m, m) : facteurs :math:`L_QL_Q^T = Q`, :math:`L_RL_R^T = R` (calculés une fois,
+    le modèle ne change pas) ; ``moments`` : :math:`(\bar x, P, X - \bar x)` de l'ensemble, calculés une
+    seule fois (le moteur les range, l'analyse réutilise la moyenne et les écarts de l'ensemble prévu)."""
 
     X: np.ndarray
     k: int
+    LQ: np.ndarray | None = None
+    LR: np.ndarray | None = None
+    moments: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
 
-def _moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Moyenne :math:`\bar x` (n,), covariance d'échantillon :math:`P` (n, n) et écarts
+    :math:`X - \bar x` (N, n) de l'ensemble ``X`` (N, n)."""
     x = X.mean(axis=0)
-    D = X - x
-    return x, symmetrize(D.T.dot(D) / (X.shape[0] - 1))
+    D = centred_rows(X, x)
+    return x, symmetrize(D.T.dot(D) / (X.shape[0] - 1)), D
 
 
 def _angles(model: NonlinearModel, idx) -> list[int]:
@@ -89,26 +97,27 @@ def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = 
                 "h_noise_jacobian."
             )
         x, P = as_gaussian(x0, P0, model.n_state, "x0", "P0")
-        return EnsembleState(x + rng.standard_normal((N, model.n_state)).dot(covariance_factor(P).T), -1)
+        X = x + rng.standard_normal((N, model.n_state)).dot(covariance_factor(P).T)
+        return EnsembleState(X, -1, covariance_factor(model.Q), np.linalg.cholesky(model.R))
 
     def predict_step(model, state, u, rng):
         X = model.transition_many(state.X, u)
-        X = X + rng.standard_normal(X.shape).dot(covariance_factor(model.Q).T)
-        return EnsembleState(X, state.k + 1)
+        X = X + rng.standard_normal(X.shape).dot(state.LQ.T)
+        return EnsembleState(X, state.k + 1, state.LQ, state.LR, _moments(X))
 
     def update_step(model, state, y, idx, rng):
         X = state.X
         HX = model.observe_many(X)
-        R = model.R
+        R, LR = model.R, state.LR
         if idx is not None:
             HX, R = HX[:, idx], R[np.ix_(idx, idx)]
+            LR = np.linalg.cholesky(R)
         angles = _angles(model, idx)
-        x_bar = X.mean(axis=0)
+        x_bar, _, dX = state.moments or _moments(X)  # moyenne et écarts de l'ensemble prévu
         y_bar = HX.mean(axis=0)
         if angles:
             y_bar[angles] = np.arctan2(np.sin(HX[:, angles]).mean(axis=0), np.cos(HX[:, angles]).mean(axis=0))
-        dX = X - x_bar
-        dY = HX - y_bar
+        dY = centred_rows(HX, y_bar)
         if angles:
             dY[:, angles] = wrap_angle(dY[:, angles])
         Pxy = dX.T.dot(dY) / (N - 1)
@@ -121,12 +130,12 @@ def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = 
         K = Kt.T
         D = y - HX
         if perturb:
-            D = D + rng.standard_normal((N, R.shape[0])).dot(np.linalg.cholesky(R).T)
+            D = D + rng.standard_normal((N, R.shape[0])).dot(LR.T)
         if angles:
             D[:, angles] = wrap_angle(D[:, angles])
         X_new = X + D.dot(K.T)
         nu = model.residual(y, y_bar, idx)
-        return EnsembleState(X_new, state.k), Correction(K, nu, S)
+        return EnsembleState(X_new, state.k, state.LQ, state.LR, _moments(X_new)), Correction(K, nu, S)
 
     def outputs(state):
         return {"members": state.X} if keep_members else {}
@@ -138,7 +147,7 @@ def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = 
         prior=prior,
         predict=predict_step,
         update=update_step,
-        moments=lambda state: _moments(state.X),
+        moments=lambda state: (state.moments or _moments(state.X))[:2],
         result_type=EnsembleFilterResult,
         stochastic=True,
         step_outputs=outputs if keep_members else None,

@@ -33,7 +33,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.angles import wrap_angle
-from ..core.linalg import covariance_factor, symmetrize
+from ..core.linalg import centred_rows, covariance_factor, symmetrize, weighted_rows
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult
 from ..core.simulation import as_generator, check_positive_int
@@ -224,12 +224,24 @@ class ParticleFilterResult(FilterResult):
             object.__setattr__(self, "resampled", flags)
 
 
+class Whitening(NamedTuple):
+    r"""Ce qu'il faut de :math:`R = LL^T` pour :math:`\log\mathcal N(y;\,h(x^i),\,R)` : ``Linv_t``
+    :math:`= (L^{-1})^T` (m, m), ``half_m_log_2pi`` :math:`= \tfrac m2\log 2\pi` et ``log_diag``
+    :math:`= \sum_j\log L_{jj} = \tfrac12\log|R|`."""
+
+    Linv_t: np.ndarray
+    half_m_log_2pi: float
+    log_diag: float
+
+
 class ParticleState(NamedTuple):
     r"""État interne du filtre : ``X`` (N, n) particules, ``logw`` (N,) log-poids normalisés et ``w`` (N,)
     les poids, ``ess``, ``increment`` :math:`\log\hat p(y_k\mid y_{1:k-1})` du dernier pas (0 sans mesure),
     ``resampled`` (le nuage a été rééchantillonné avant la dernière prédiction), ``k`` : indice de la mesure
     visée (pour nommer le pas dans un message d'erreur), ``LQ`` : facteur :math:`L_QL_Q^T = Q` (calculé une
-    fois)."""
+    fois) ; ``white`` : :class:`Whitening` de la covariance de mesure complète (calculé une fois, ``None``
+    si elle n'est pas constante) ; ``moments`` : :math:`(\hat x, P, X - \hat x)` du nuage pondéré, calculés
+    une seule fois par nuage (le moteur les range, la correction réutilise les écarts du nuage prédit)."""
 
     X: np.ndarray
     logw: np.ndarray
@@ -239,6 +251,8 @@ class ParticleState(NamedTuple):
     resampled: bool
     k: int
     LQ: np.ndarray
+    white: Whitening | None = None
+    moments: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
 
 # --------------------------------------------------------------------------- famille
@@ -273,25 +287,42 @@ def _noise(model: NonlinearModel, X: np.ndarray, u, gen: np.random.Generator, LQ
     return np.array([model.process_noise_gain(x, u).dot(p) for x, p in zip(X, phi)])
 
 
-def _log_likelihoods(model: NonlinearModel, HX: np.ndarray, y: np.ndarray, R: np.ndarray, idx) -> np.ndarray:
-    r""":math:`\log\mathcal N(y;\,h(x^i),\,R)` pour chaque particule, (N,)."""
+def _whitening(R: np.ndarray) -> Whitening:
+    r""":class:`Whitening` de ``R`` (m, m) définie positive (Cholesky :math:`R = LL^T`, puis :math:`L^{-1}`)."""
+    L = scipy.linalg.cholesky(R, lower=True, check_finite=False)
+    Linv = scipy.linalg.solve_triangular(L, np.eye(R.shape[0]), lower=True, check_finite=False)
+    return Whitening(Linv.T, 0.5 * R.shape[0] * _LOG_2PI, np.log(np.diag(L)).sum())
+
+
+def _log_likelihoods(model: NonlinearModel, HX: np.ndarray, y: np.ndarray, white: Whitening, idx) -> np.ndarray:
+    r""":math:`\log\mathcal N(y;\,h(x^i),\,R) = -\tfrac12\lVert L^{-1}(y - h(x^i))\rVert^2 - \tfrac m2\log 2\pi
+    - \tfrac12\log|R|` pour chaque particule, (N,) ; ``white`` : :class:`Whitening` de :math:`R`."""
     D = y - HX
     if model.angle_indices:
         angles = list(model.angle_indices) if idx is None else [j for j, i in enumerate(idx) if int(i) in model.angle_indices]
         if angles:
             D[:, angles] = wrap_angle(D[:, angles])
-    L = scipy.linalg.cholesky(R, lower=True, check_finite=False)
-    Linv = scipy.linalg.solve_triangular(L, np.eye(R.shape[0]), lower=True, check_finite=False)
-    Z = D.dot(Linv.T)  # lignes : L⁻¹(y − h(xⁱ)), blanchies
+    Z = D.dot(white.Linv_t)  # lignes : L⁻¹(y − h(xⁱ)), blanchies
     with np.errstate(over="ignore", invalid="ignore"):
         maha = np.einsum("ij,ij->i", Z, Z)
-    return -0.5 * maha - 0.5 * R.shape[0] * _LOG_2PI - np.log(np.diag(L)).sum()
+    return -0.5 * maha - white.half_m_log_2pi - white.log_diag
 
 
-def _weighted_moments(X: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _weighted_moments(X: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Moyenne et covariance pondérées :math:`\hat x = \sum_i w^ix^i`,
+    :math:`P = \sum_i w^i(x^i - \hat x)(x^i - \hat x)^T`, et les poids fois les écarts
+    :math:`w^i(x^i - \hat x)` (N, n), qui resservent à la covariance croisée."""
     x = w.dot(X)
-    D = X - x
-    return x, symmetrize(D.T.dot(w[:, None] * D))
+    D = centred_rows(X, x)
+    WD = weighted_rows(w, D)
+    return x, symmetrize(D.T.dot(WD)), WD
+
+
+def _cloud_moments(X: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r""":math:`(\hat x, P, X - \hat x)` du nuage ``X`` (N, n) de poids ``w`` (N,)."""
+    x = w.dot(X)
+    D = centred_rows(X, x)
+    return x, symmetrize(D.T.dot(weighted_rows(w, D))), D
 
 
 def particle_family(
@@ -312,24 +343,29 @@ def particle_family(
         _check_model(model)
         x, P = as_gaussian(x0, P0, model.n_state, "x0", "P0")
         X = x + rng.standard_normal((N, model.n_state)).dot(covariance_factor(P).T)
-        return ParticleState(X, log_uniform, uniform, float(N), 0.0, False, -1, covariance_factor(model.Q))
+        # R ramenée à la mesure est constante (V constante, vérifié ci-dessus) : factorisée une fois
+        white = _whitening(model.measurement_noise(X[0]))
+        return ParticleState(X, log_uniform, uniform, float(N), 0.0, False, -1, covariance_factor(model.Q), white)
 
     def predict_step(model, state, u, rng):
         X, logw, w, ess = state.X, state.logw, state.w, state.ess
         resampled = ess < tau * N
         if resampled:
-            X = X[scheme.function(w, scheme.draws(w, rng))]
+            X = X.take(scheme.function(w, scheme.draws(w, rng)), axis=0)  # X[indices], sans l'indexation lente
             logw, w, ess = log_uniform, uniform, float(N)
         X = model.transition_many(X, u) + _noise(model, X, u, rng, state.LQ)
-        return ParticleState(X, logw, w, ess, 0.0, resampled, state.k + 1, state.LQ)
+        return ParticleState(X, logw, w, ess, 0.0, resampled, state.k + 1, state.LQ, state.white,
+                             _cloud_moments(X, w))
 
     def update_step(model, state, y, idx, rng):
         X, logw, w_prev = state.X, state.logw, state.w
         HX = model.observe_many(X)
         R = model.measurement_noise(X[0])
+        white = state.white
         if idx is not None:
             HX, R = HX[:, idx], R[np.ix_(idx, idx)]
-        joint = logw + _log_likelihoods(model, HX, y, R, idx)
+            white = _whitening(R)
+        joint = logw + _log_likelihoods(model, HX, y, white, idx)
         top = joint.max()
         if not np.isfinite(top):
             raise KalmanInputError(
@@ -343,17 +379,23 @@ def particle_family(
         w = np.exp(new_logw)
         w /= w.sum()  # efface les arrondis (Σw = 1 à 1e-16 près)
         ess = float(1.0 / np.dot(w, w))
-        # correction « linéaire équivalente » du nuage prédit : ŷ, S, P_xy, K = P_xy S⁻¹ (pour la NIS)
-        y_hat, Pyy = _weighted_moments(HX, w_prev)
+        # correction « linéaire équivalente » du nuage prédit : ŷ, S, P_xy, K = P_xy S⁻¹ (pour la NIS) ;
+        # P_xy = Σ wⁱ(xⁱ − x̂⁻)(h(xⁱ) − ŷ)ᵀ avec les écarts xⁱ − x̂⁻ du nuage prédit (déjà calculés)
+        D = (state.moments or _cloud_moments(X, w_prev))[2]
+        y_hat, Pyy, WDy = _weighted_moments(HX, w_prev)
         S = Pyy + R
-        Pxy = (X - w_prev.dot(X)).T.dot(w_prev[:, None] * (HX - y_hat))
-        K = scipy.linalg.solve(S, Pxy.T, assume_a="pos", check_finite=False).T
+        Pxy = D.T.dot(WDy)
+        if S.shape[0] == 1:  # S scalaire : K = P_xy / S (ce que fait scipy.linalg.solve pour 1 × 1)
+            K = Pxy / S
+        else:
+            K = scipy.linalg.solve(S, Pxy.T, assume_a="pos", check_finite=False).T
         nu = model.residual(y, y_hat, idx)
-        state = ParticleState(X, new_logw, w, ess, increment, state.resampled, state.k, state.LQ)
+        state = ParticleState(X, new_logw, w, ess, increment, state.resampled, state.k, state.LQ, state.white,
+                              _cloud_moments(X, w))
         return state, Correction(K, nu, S)
 
     def moments(state):
-        return _weighted_moments(state.X, state.w)
+        return (state.moments or _cloud_moments(state.X, state.w))[:2]
 
     def outputs(state):
         out = {"ess": state.ess, "log_likelihood_increments": state.increment, "resampled": state.resampled}

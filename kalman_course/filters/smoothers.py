@@ -51,7 +51,7 @@ from .diffuse import DiffuseFilterResult, is_determined
 from .extended import NONLINEAR_HINT
 
 __all__ = ["SmootherResult", "rts_smoother", "extended_rts_smoother", "unscented_rts_smoother", "smoother_gains",
-           "rts_pass", "CONSISTENCY_RTOL"]
+           "rts_pass", "diffuse_rts_pass", "CONSISTENCY_RTOL"]
 
 #: Tolérance relative de la vérification « ce résultat vient du filtre de ce modèle ».
 CONSISTENCY_RTOL = 1e-6
@@ -140,20 +140,64 @@ def rts_pass(x: np.ndarray, P: np.ndarray, x_pred: np.ndarray, P_pred: np.ndarra
 
     ``x`` (T, n) — ou (T, n, c) : plusieurs moyennes filtrées ensemble, comme le filtre augmenté du
     départ diffus — ``P`` (T, n, n), ``x_pred``, ``P_pred`` du filtre. Renvoie ``(xs, Ps, P_lag)`` ;
-    ``P_lag[k]`` :math:`= P_{k\mid T}G_{k-1}^T` pour :math:`k \ge 1`, NaN en 0."""
+    ``P_lag[k]`` :math:`= P_{k\mid T}G_{k-1}^T` pour :math:`k \ge 1`, NaN en 0.
+
+    Seule la récurrence est dans la boucle ; les lignes sont lues dans des listes de vues (pas d'indexation
+    de tableau à chaque pas) et les résultats empilés à la fin."""
     T = x.shape[0]
-    xs = np.empty_like(x)
-    Ps = np.empty_like(P)
-    xs[-1], Ps[-1] = x[-1], P[-1]
-    x_next, P_next = xs[-1], Ps[-1]
-    for k in range(T - 2, -1, -1):
-        Gk = G[k]
-        x_next = x[k] + Gk.dot(x_next - x_pred[k + 1])
-        Pk = P[k] + Gk.dot(P_next - P_pred[k + 1]).dot(Gk.T)
-        P_next = 0.5 * (Pk + Pk.T)  # symétrisation (arrondis)
-        xs[k], Ps[k] = x_next, P_next
+    x_next, P_next = x[-1].copy(), P[-1].copy()
+    xs_rev, Ps_rev = [x_next], [P_next]
+    # lignes k = T-2 … 0 : (x_k, P_k, G_k, x⁻_{k+1}, P⁻_{k+1})
+    rows = zip(list(x[-2::-1]), list(P[-2::-1]), list(G[-2::-1]), list(x_pred[:0:-1]), list(P_pred[:0:-1]))
+    scalar = P.shape[-1] == 1  # une covariance 1 × 1 est symétrique : rien à symétriser
+    for xk, Pk, Gk, xp_next, Pp_next in rows:
+        x_next = xk + Gk.dot(x_next - xp_next)
+        P_next = Pk + Gk.dot(P_next - Pp_next).dot(Gk.T)
+        if not scalar:
+            P_next = symmetrize(P_next)  # symétrisation (arrondis)
+        xs_rev.append(x_next)
+        Ps_rev.append(P_next)
+    xs = np.array(xs_rev[::-1]).reshape(x.shape)
+    Ps = np.array(Ps_rev[::-1]).reshape(P.shape)
     lag = np.full_like(P, np.nan)
-    lag[1:] = Ps[1:] @ np.swapaxes(G[:-1], 1, 2)  # Cov(x_{k+1}, x_k | y) = P_{k+1|T} G_kᵀ
+    if T > 1:
+        lag[1:] = Ps[1:] @ G[:-1].swapaxes(1, 2)  # Cov(x_{k+1}, x_k | y) = P_{k+1|T} G_kᵀ
+    return xs, Ps, lag
+
+
+def diffuse_rts_pass(A: np.ndarray, augmented: FilterResult, J: np.ndarray, h: np.ndarray):
+    r"""Lissage exact du départ diffus, sans vérification (le noyau de :func:`rts_smoother` pour un
+    :class:`~kalman_course.filters.diffuse.DiffuseFilterResult`, appelé tel quel par l'étape E d'EM, qui
+    filtre elle-même et n'a rien à vérifier).
+
+    On lisse le filtre augmenté (moyennes :math:`[a \mid X]` affines en :math:`\delta`, covariance
+    :math:`P^a`) avec ses gains :math:`G^a_k = P^a_kA^T(P^{a-}_{k+1})^{-1}`, puis on intègre
+    :math:`\delta \sim \mathcal N(J_T^{-1}h_T, J_T^{-1})` :
+
+    .. math::
+
+        \hat x_{k\mid T} = a^s_k + X^s_kJ_T^{-1}h_T,\quad P_{k\mid T} = P^{a,s}_k + X^s_kJ_T^{-1}X^{sT}_k,\quad
+        \operatorname{Cov}(x_{k+1}, x_k\mid y) = P^{a,s}_{k+1}G^{aT}_k + X^s_{k+1}J_T^{-1}X^{sT}_k.
+
+    ``A`` (n, n) ; ``augmented`` : le filtre augmenté (``x``, ``x_pred`` (T, n, 1+n), ``P``, ``P_pred``
+    (T, n, n)) ; ``J`` (n, n) définie positive, ``h`` (n,) : :math:`J_T`, :math:`h_T`. Renvoie
+    ``(x (T, n), P (T, n, n), P_lag (T, n, n))`` (``P_lag[0]`` NaN)."""
+    n = A.shape[0]
+    G_a = np.zeros_like(augmented.P)
+    T = G_a.shape[0]
+    if T > 1:
+        G_a[:-1] = smoother_gains(augmented.P[:-1], augmented.P_pred[1:], A)
+    xs_a, Ps_a, lag_a = rts_pass(augmented.x, augmented.P, augmented.x_pred, augmented.P_pred, G_a)
+    Xs = xs_a[:, :, 1:]
+    cho = scipy.linalg.cho_factor(J, lower=True)
+    delta = scipy.linalg.cho_solve(cho, h)
+    # J⁻¹Xₖᵀ pour tous les pas d'une seule résolution : J⁻¹[X₀ᵀ … X_{T-1}ᵀ]
+    JiXt = scipy.linalg.cho_solve(cho, Xs.swapaxes(1, 2).transpose(1, 0, 2).reshape(n, T * n))
+    JiXt = JiXt.reshape(n, T, n).transpose(1, 0, 2)  # (T, n, n)
+    xs = xs_a[:, :, 0] + Xs @ delta
+    Ps = symmetrize(Ps_a + Xs @ JiXt)
+    lag = np.full_like(Ps, np.nan)
+    lag[1:] = lag_a[1:] + Xs[1:] @ JiXt[:-1]
     return xs, Ps, lag
 
 
@@ -345,20 +389,7 @@ def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> Smo
             "Les mesures ne déterminent pas l'état (information J_T singulière : modèle non observable "
             "ou trop peu de mesures) : pas de lissage possible sans a priori."
         )
-    G_a = np.zeros_like(aug.P)
-    if result.n_steps > 1:
-        G_a[:-1] = smoother_gains(aug.P[:-1], aug.P_pred[1:], A)
-    xs_a, Ps_a, lag_a = rts_pass(aug.x, aug.P, aug.x_pred, aug.P_pred, G_a)
-    Xs = xs_a[:, :, 1:]
-    cho = scipy.linalg.cho_factor(J, lower=True)
-    delta = scipy.linalg.cho_solve(cho, h)
-    T = Xs.shape[0]  # J⁻¹Xₖᵀ pour tous les pas d'une seule résolution : J⁻¹[X₀ᵀ … X_{T-1}ᵀ]
-    JiXt = scipy.linalg.cho_solve(cho, np.swapaxes(Xs, 1, 2).transpose(1, 0, 2).reshape(n, T * n))
-    JiXt = JiXt.reshape(n, T, n).transpose(1, 0, 2)  # (T, n, n)
-    xs = xs_a[:, :, 0] + Xs @ delta
-    Ps = symmetrize(Ps_a + Xs @ JiXt)
-    lag = np.full_like(Ps, np.nan)
-    lag[1:] = lag_a[1:] + Xs[1:] @ JiXt[:-1]
+    xs, Ps, lag = diffuse_rts_pass(A, aug, J, h)
     # gains du filtre exact là où son estimation est déterminée
     G = np.full_like(Ps, np.nan)
     G[-1] = 0.0
