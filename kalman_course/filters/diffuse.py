@@ -50,7 +50,7 @@ import numpy as np
 
 from ..core.linalg import correct, symmetrize
 from ..core.models import LinearGaussianModel
-from ..core.results import FilterResult, freeze
+from ..core.results import FilterResult
 from .engine import Correction, FilterFamily, gaussian_moments, run_filter
 
 __all__ = ["DIFFUSE_RTOL", "DiffuseFilterResult", "diffuse_family", "diffuse_kalman_filter", "is_determined"]

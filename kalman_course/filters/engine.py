@@ -234,7 +234,6 @@ def run_filter(
     return out.result(family.result_type, **{name: np.stack(values) for name, values in extras.items()})
 
 
-
 def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, u: Any = None) -> FilterRuns:
     r"""Applique la famille ``family`` à ``N`` tirages indépendants du même modèle, tous à la fois : à
     chaque pas, une prédiction puis une correction sur la pile des tirages (axe des tirages en tête).

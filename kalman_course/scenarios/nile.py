@@ -44,7 +44,6 @@ from ..likelihood import (
     MaximumLikelihood,
     expectation_maximization,
     filter_log_likelihood,
-    log_likelihood,
     log_likelihoods,
     maximum_likelihood,
 )
