@@ -164,6 +164,18 @@ def test_a_stack_result_that_disagrees_with_the_single_call_is_not_used():
         np.testing.assert_allclose(res.run(i).P, ref.P, rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize("name, batch, single",
+                         FILTERS + [("KF", kc.kalman_filter_runs, kc.kalman_filter)], ids=IDS + ["KF"])
+def test_scalar_prior_accepted_like_the_single_run_filter(name, batch, single):
+    """Un état scalaire (n = 1) : x0 et P0 scalaires, acceptés par le filtre seul, le sont aussi en lot."""
+    linear = kc.LinearGaussianModel(A=0.9, C=1.0, Q=0.1, R=0.5)
+    model = linear if name == "KF" else kc.NonlinearModel.from_linear(linear)
+    Y = np.random.default_rng(2).standard_normal((4, 15))
+    runs = batch(model, Y, 0.3, 2.0)
+    for i in range(4):
+        np.testing.assert_allclose(runs.run(i).x, single(model, Y[i], 0.3, 2.0).x, rtol=1e-12, atol=1e-14)
+
+
 def test_common_control_is_used_by_every_run():
     lin = kc.LinearGaussianModel(np.eye(2), [[1.0, 0.0]], 0.1 * np.eye(2), [[0.5]], B=[[1.0], [0.5]])
     model = kc.NonlinearModel.from_linear(lin)

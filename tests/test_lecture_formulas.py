@@ -13,7 +13,7 @@ import scipy.linalg
 
 import kalman_course as kc
 from conftest import filterpy_kf, random_model
-from kalman_course.scenarios import engine
+from kalman_course.scenarios import engine, stability
 
 # --------------------------------------------------------------------------- chapitre « Contrôle »
 
@@ -100,6 +100,21 @@ def test_linear_estimator_runs_is_the_kalman_filter_on_each_run():
         kc.linear_estimator_runs(model, np.full((2, 25, 2), np.nan), x0, K, u=u)
     with pytest.raises(kc.KalmanInputError, match=r"« estimator » \(batch=True\) doit renvoyer .* \(5, 25, 3\)"):
         kc.monte_carlo(model, lambda Y: Y, 25, 5, x0_mean=x0, x0_cov=P0, x0_hat=x0, rng=1, u=u, batch=True)
+
+
+@pytest.mark.parametrize("K", [0.4, 0.6])
+def test_fixed_gain_experiment_follows_the_closed_form(K):
+    """L'expérience de la figure « estimateur-stabilite » et des curseurs : erreur moyenne
+    E[e_n] = ((1 − KC)A)ⁿ (forme close, e_0 = 1) ; moyenne de Monte-Carlo à moins de 4 erreurs types."""
+    run = stability.fixed_gain_experiment(K)
+    factor = (1.0 - K * stability.COUNTER_C) * stability.COUNTER_A
+    closed = factor ** np.arange(stability.STABILITY_STEPS + 1)
+    np.testing.assert_allclose(run.recursion.e[:, 0], closed, rtol=1e-12)
+    assert run.radius == pytest.approx(abs(factor), rel=1e-12)
+    assert run.printed_radius == pytest.approx(abs(1.0 - K), rel=1e-12)
+    assert run.monte_carlo.n_runs == stability.STABILITY_RUNS
+    mean, sem = run.monte_carlo.mean_error()[1:, 0], run.monte_carlo.mean_error_sem()[1:, 0]
+    assert np.all(np.abs(mean - closed[1:]) < 4 * sem)
 
 
 def test_linear_estimator_with_conditions_is_the_kalman_filter_and_filterpy():

@@ -86,6 +86,21 @@ def as_vector(name: str, value: Any, n: int) -> np.ndarray:
     return arr
 
 
+def as_batch_vector(name: str, value: Any, n: int, N: int) -> np.ndarray:
+    """Vecteur de ``N`` tirages ``(N, n)`` : ``(n,)`` commun à tous les tirages (scalaire accepté si
+    ``n == 1``, comme :func:`as_vector`) ou ``(N, n)`` un par tirage. Renvoie une copie ``(N, n)``."""
+    arr = as_float_array(name, value)
+    if arr.ndim == 0 and n == 1:
+        arr = arr.reshape(1)
+    if arr.shape == (n,):
+        return np.tile(arr, (N, 1))
+    if arr.shape != (N, n):
+        raise KalmanInputError(
+            f"« {name} » doit être de forme ({n},) (commun) ou ({N}, {n}) (un par tirage) ; reçu {shape_text(arr.shape)}."
+        )
+    return arr.copy()
+
+
 def as_matrix(
     name: str, value: Any, rows: int | None, cols: int | None, free_rows: str = "m", free_cols: str = "p"
 ) -> np.ndarray:

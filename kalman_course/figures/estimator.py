@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
-from ..lecture.estimator import linear_estimator_runs, mean_error_recursion
-from ..core.models import LinearGaussianModel
+from ..numbers import format_number
 from ..scenarios.engine import ENGINE_DT, mean_error_experiment
-from ..diagnostics.monte_carlo import monte_carlo
+from ..scenarios.stability import STABILITY_RUNS, fixed_gain_experiment
 from ._registry import new_figure, register
 
 CHAPTER = "estimateur"
@@ -39,23 +39,8 @@ def mean_error_figure():
     return fig
 
 
-#: Contre-exemple de l'erratum 001-3 : système instable, mesure directe.
-COUNTER_EXAMPLE = dict(A=2.0, C=1.0, Q=0.01, R=0.01)
+#: Les deux gains de la figure : la condition imprimée |1 − KC| < 1 tient pour les deux.
 COUNTER_GAINS = (0.4, 0.6)
-
-
-def stability_experiment(K: float, n_steps: int = 20, n_runs: int = 400):
-    """Gain fixe ``K`` sur le contre-exemple :math:`A = 2, C = 1` : Monte-Carlo et récurrence, :math:`\\hat x_0 - x_0 = 1`."""
-    model = LinearGaussianModel(**COUNTER_EXAMPLE)
-    Kmat = np.array([[K]])
-
-    def estimator(Y):
-        return linear_estimator_runs(model, Y, [1.0], Kmat)
-
-    mc = monte_carlo(model, estimator, n_steps, n_runs, x0_mean=[0.0], x0_cov=[[0.0]], x0_hat=[1.0], rng=3,
-                     batch=True)
-    rec = mean_error_recursion(model, Kmat, x0_mean=[0.0], x0_hat=[1.0], n_steps=n_steps)
-    return mc, rec
 
 
 @register("estimateur-stabilite", chapter=CHAPTER, title="Stabilité : (I − KC) ne suffit pas, c'est (I − KC)A qui compte")
@@ -63,15 +48,17 @@ def stability_figure():
     fig, ax = new_figure(width=7.0, height=3.8)
     colors = {0.4: "tab:red", 0.6: "tab:green"}
     for K in COUNTER_GAINS:
-        mc, rec = stability_experiment(K)
+        run = fixed_gain_experiment(K)
+        mc, rec = run.monte_carlo, run.recursion
         n = np.arange(rec.e.shape[0])
-        rho_printed = abs(1 - K * COUNTER_EXAMPLE["C"])
-        rho = abs((1 - K * COUNTER_EXAMPLE["C"]) * COUNTER_EXAMPLE["A"])
-        label = rf"$K = {K:g}$ : $|1-KC| = {rho_printed:.1f}$, $|(1-KC)A| = {rho:.1f}$".replace(".", "{,}")
+        # nombres hors des formules : mathtext espacerait la virgule décimale
+        label = (rf"$K$ = {format_number(K, decimals=1)} : $|1-KC|$ = {format_number(run.printed_radius, decimals=1)}, "
+                 rf"$|(1-KC)A|$ = {format_number(run.radius, decimals=1)}")
         ax.semilogy(n, np.abs(rec.e[:, 0]), color=colors[K], lw=1.8, label=label)
         ax.semilogy(n[1::2], np.abs(mc.mean_error()[1::2, 0]), "o", ms=3.5, color=colors[K], alpha=0.7)
-    ax.plot([], [], "o", ms=3.5, color="0.4", label="moyenne de Monte-Carlo (400 tirages)")
+    ax.plot([], [], "o", ms=3.5, color="0.4", label=f"moyenne de Monte-Carlo ({STABILITY_RUNS} tirages)")
     ax.set_xlabel("itération n (sans unité)")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel(r"$|\mathbb{E}[e_n]|$ (unités de x)")
     ax.set_title(r"Contre-exemple $A = 2$, $C = 1$ : l'erreur moyenne est multipliée par $(1-KC)A$")
     ax.grid(alpha=0.3, which="both")

@@ -46,6 +46,7 @@ from ..core.simulation import as_generator
 from ..core.validation import (
     KalmanInputError,
     as_batch_measurements,
+    as_batch_vector,
     as_controls,
     as_float_array,
     as_gaussian,
@@ -130,13 +131,7 @@ def gaussian_prior_many(model: Any, x0: Any, P0: Any, N: int, definite: bool = F
     (N, n, n) une par tirage, symétrique semi-définie positive (``definite=True`` : définie positive).
     Renvoie ``(X0 (N, n), P0 (N, n, n))`` (copies)."""
     n = model.n_state
-    X0 = as_float_array("x0", x0)
-    if X0.shape == (n,):
-        X0 = np.broadcast_to(X0, (N, n))
-    elif X0.shape != (N, n):
-        raise KalmanInputError(
-            f"« x0 » doit être de forme ({n},) (commun) ou ({N}, {n}) (un par tirage) ; reçu {shape_text(X0.shape)}."
-        )
+    X0 = as_batch_vector("x0", x0, n, N)
     check = check_pd if definite else check_psd
     P = as_float_array("P0", P0)
     if P.ndim == 3:
@@ -149,7 +144,7 @@ def gaussian_prior_many(model: Any, x0: Any, P0: Any, N: int, definite: bool = F
             check(f"P0[{i}]", P[i])
     else:
         P = np.broadcast_to(check("P0", as_square_matrix("P0", P, n)), (N, n, n))
-    return np.array(X0, dtype=float), np.array(P, dtype=float)
+    return X0, np.array(P, dtype=float)
 
 
 def gaussian_moments(state: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

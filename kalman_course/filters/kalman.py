@@ -18,6 +18,8 @@ from ..core.linalg import S_NOT_PD, correct, kalman_gain, symmetrize
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult, FilterRuns
 from ..core.validation import (
+    as_batch_measurements,
+    as_batch_vector,
     KalmanInputError,
     as_float_array,
     as_gaussian,
@@ -246,7 +248,7 @@ def kalman_filter_runs(
     ----------
     model : LinearGaussianModel
     Y : (N, T, m), ou (N, T) si m = 1 — mesures des ``N`` tirages ; ``NaN`` : composante manquante.
-    x0 : (n,) commun, ou (N, n) un par tirage. P0 : (n, n) commun.
+    x0 : (n,) commun (scalaire si n = 1), ou (N, n) un par tirage. P0 : (n, n) commun.
     u : (T, p) commun, ou (N, T, p), optionnel.
     joseph : forme de Joseph pour la covariance a posteriori.
 
@@ -256,22 +258,9 @@ def kalman_filter_runs(
     """
     model = check_instance("model", model, LinearGaussianModel, "pour un modèle non linéaire, bouclez sur extended_kalman_filter")
     n, m = model.n_state, model.n_obs
-    Yarr = as_float_array("Y", Y, allow_nan=True)
-    if Yarr.ndim == 2 and m == 1:
-        Yarr = Yarr[:, :, None]
-    if Yarr.ndim != 3 or Yarr.shape[2] != m or Yarr.shape[0] == 0 or Yarr.shape[1] == 0:
-        extra = " ou (N, T)" if m == 1 else ""
-        raise KalmanInputError(
-            f"« Y » doit être de forme (N, T, {m}){extra} : N tirages de T mesures ; reçu {shape_text(Yarr.shape)}."
-        )
+    Yarr = as_batch_measurements("Y", Y, m)
     N, T, _ = Yarr.shape
-    X0 = as_float_array("x0", x0)
-    if X0.shape == (n,):
-        X0 = np.broadcast_to(X0, (N, n)).copy()
-    elif X0.shape != (N, n):
-        raise KalmanInputError(
-            f"« x0 » doit être de forme ({n},) (commun) ou ({N}, {n}) (un par tirage) ; reçu {shape_text(X0.shape)}."
-        )
+    X0 = as_batch_vector("x0", x0, n, N)
     P = check_psd("P0", as_square_matrix("P0", P0, n))
     BU = _batch_controls(model, u, N, T)  # None, (T, n) ou (N, T, n)
     observed = ~np.isnan(Yarr)

@@ -20,7 +20,8 @@ from ..core.models import LinearGaussianModel
 from ..core.validation import KalmanInputError, as_float_array
 from ..diagnostics.monte_carlo import MonteCarlo, monte_carlo
 from ..lecture.errata import printed_stability_radius
-from ..lecture.estimator import MeanError, error_transition, linear_estimator, mean_error_recursion, spectral_radius
+from ..lecture.estimator import (MeanError, error_transition, linear_estimator_runs, mean_error_recursion,
+                                 spectral_radius)
 
 __all__ = ["COUNTER_A", "COUNTER_C", "COUNTER_NOISE", "STABILITY_STEPS", "STABILITY_RUNS", "STABILITY_SEED",
            "counter_example_model", "FixedGainRun", "fixed_gain_experiment"]
@@ -57,18 +58,20 @@ class FixedGainRun:
 def fixed_gain_experiment(K: float, A: float = COUNTER_A, n_steps: int = STABILITY_STEPS,
                           n_runs: int = STABILITY_RUNS, rng: Any = STABILITY_SEED) -> FixedGainRun:
     r"""Gain fixe ``K`` sur le contre-exemple : ``n_runs`` tirages (:math:`x_0 = 0` exactement,
-    :math:`\hat x_0 = 1`) estimés par :func:`~kalman_course.linear_estimator`, et la récurrence
-    :func:`~kalman_course.mean_error_recursion` de l'erreur moyenne."""
+    :math:`\hat x_0 = 1`) estimés en lot par :func:`~kalman_course.linear_estimator_runs`, et la récurrence
+    :func:`~kalman_course.mean_error_recursion` de l'erreur moyenne. Calcul de la figure
+    « estimateur-stabilite » et des curseurs du chapitre."""
     k = as_float_array("K", K)
     if k.ndim != 0 or not np.isfinite(k):
         raise KalmanInputError(f"« K » doit être un gain scalaire fini ; reçu {K!r}.")
     model = counter_example_model(A)
     Kmat = np.array([[float(k)]])
 
-    def estimator(y):
-        return linear_estimator(model, y, [1.0], Kmat)
+    def estimator(Y):
+        return linear_estimator_runs(model, Y, [1.0], Kmat)
 
-    mc = monte_carlo(model, estimator, n_steps, n_runs, x0_mean=[0.0], x0_cov=[[0.0]], x0_hat=[1.0], rng=rng)
+    mc = monte_carlo(model, estimator, n_steps, n_runs, x0_mean=[0.0], x0_cov=[[0.0]], x0_hat=[1.0], rng=rng,
+                     batch=True)
     rec = mean_error_recursion(model, Kmat, x0_mean=[0.0], x0_hat=[1.0], n_steps=n_steps)
     return FixedGainRun(mc, rec, spectral_radius(error_transition(model, Kmat)),
                         float(printed_stability_radius(model, Kmat)))
