@@ -58,7 +58,7 @@ def stability_figure():
         ax.semilogy(n[1::2], np.abs(mc.mean_error()[1::2, 0]), "o", ms=3.5, color=colors[K], alpha=0.7)
     ax.plot([], [], "o", ms=3.5, color="0.4", label=f"moyenne de Monte-Carlo ({STABILITY_RUNS} tirages)")
     ax.set_xlabel("itération n (sans unité)")
-    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True, steps=[1, 2, 5, 10]))
     ax.set_ylabel(r"$|\mathbb{E}[e_n]|$ (unités de x)")
     ax.set_title(r"Contre-exemple $A = 2$, $C = 1$ : l'erreur moyenne est multipliée par $(1-KC)A$")
     ax.grid(alpha=0.3, which="both")
