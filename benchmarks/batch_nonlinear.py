@@ -5,7 +5,7 @@ et azimut, modèle vectorisé) : pour l'EKF, l'UKF et l'EKF itéré, temps CPU d
 tirage (``extended_kalman_filter``…) et du filtre en lot (``extended_kalman_filter_runs``…), meilleur de
 3, BLAS sur un fil ; puis ``distant_target_comparison()`` entière (celle du paquet, en lot) contre la
 même expérience écrite tirage par tirage (la version d'avant le mode en lot, recopiée ici), avec l'écart
-relatif maximal de l'erreur de position et de la NEES (il doit rester sous 1e-9 : mêmes tirages, mêmes
+relatif maximal de l'erreur de position et de la NEES (il doit rester sous 10⁻⁹ : mêmes tirages, mêmes
 nombres).
 
 Usage : .venv/bin/python benchmarks/batch_nonlinear.py
@@ -23,24 +23,16 @@ import kalman_course as kc
 from kalman_course.filters.extended import extended_kalman_filter_runs
 from kalman_course.filters.iterated import iterated_extended_kalman_filter_runs
 from kalman_course.filters.unscented import unscented_kalman_filter_runs
+from kalman_course.numbers import format_spec
 from kalman_course.scenarios import distant_target as dt
 
 REPEAT = 3
 MAX_GAP = 1e-9
 
 
-def fr(value: float, digits: int = 3) -> str:
-    """Nombre à virgule décimale."""
-    return f"{value:.{digits}f}".replace(".", ",")
-
-
 def fr_sci(value: float) -> str:
-    """Petit nombre en notation scientifique française (2,3×10⁻¹³)."""
-    if value == 0:
-        return "0"
-    mantissa, exponent = f"{value:.1e}".split("e")
-    sup = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
-    return f"{mantissa.replace('.', ',')}×10{str(int(exponent)).translate(sup)}"
+    """Petit écart en notation scientifique française (« 2,3 × 10⁻¹³ ») ; un écart nul s'écrit « 0 »."""
+    return format_spec(value, ".1e" if value != 0 else "d")
 
 
 def best_cpu(func: Callable[[], Any]) -> tuple[float, Any]:
@@ -90,20 +82,22 @@ def main() -> None:
     }
     failed = False
     with threadpool_limits(1, "blas"):
-        print(f"Cible lointaine : {Y.shape[0]} tirages × {Y.shape[1]} pas, temps CPU, meilleur de {REPEAT}, BLAS sur 1 fil")
+        print(f"Cible lointaine : {format_spec(Y.shape[0], 'd')} tirages × {format_spec(Y.shape[1], 'd')} pas, "
+              f"temps CPU, meilleur de {format_spec(REPEAT, 'd')}, BLAS sur 1 fil")
         for name, (single, batch) in pairs.items():
             t_one, ref = best_cpu(lambda single=single: [single(r) for r in runs])
             t_lot, res = best_cpu(batch)
             gap = max(float(np.max(np.abs(res.x[i] - ref[i].x))) for i in range(len(runs)))
-            print(f"  {name:<10} tirage par tirage {fr(t_one)} s, en lot {fr(t_lot)} s : "
-                  f"{fr(t_one / t_lot, 1)} × plus rapide (écart maximal des estimations {fr_sci(gap)} m)")
+            print(f"  {name:<10} tirage par tirage {format_spec(t_one, '.3f')} s, "
+                  f"en lot {format_spec(t_lot, '.3f')} s : {format_spec(t_one / t_lot, '.1f')} × plus rapide "
+                  f"(écart maximal des estimations {fr_sci(gap)} m)")
             failed |= gap > 1e-6
         t_old, old = best_cpu(comparison_run_by_run)
         t_new, new = best_cpu(dt.distant_target_comparison)
     gaps = [float(np.max(np.abs(new_d[name] - old_d[name]) / np.abs(old_d[name])))
             for old_d, new_d in ((old.position_error, new.position_error), (old.nees, new.nees)) for name in old_d]
-    print(f"distant_target_comparison() : tirage par tirage {fr(t_old)} s, en lot {fr(t_new)} s : "
-          f"{fr(t_old / t_new, 1)} × plus rapide")
+    print(f"distant_target_comparison() : tirage par tirage {format_spec(t_old, '.3f')} s, "
+          f"en lot {format_spec(t_new, '.3f')} s : {format_spec(t_old / t_new, '.1f')} × plus rapide")
     print(f"écart relatif maximal (erreur de position et NEES, 3 filtres) : {fr_sci(max(gaps))} "
           f"(tolérance {fr_sci(MAX_GAP)})")
     if failed or max(gaps) > MAX_GAP:

@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 import kalman_course as kc
+from kalman_course.numbers import format_spec
 
 TARGET_S = 15.0
 
@@ -36,8 +37,9 @@ def timed_command(out: Path, *args: str) -> float:
     subprocess.run([sys.executable, "-m", "kalman_course.figures", "--out", str(out), *args],
                    check=True, capture_output=True)
     elapsed = time.perf_counter() - start
-    print(f"  {' '.join(args)} : {elapsed:.1f} s écoulées, {_children_cpu() - cpu:.1f} s CPU, "
-          f"charge moyenne {os.getloadavg()[0]:.1f} sur {os.cpu_count()} cœurs")
+    print(f"  {' '.join(args)} : {format_spec(elapsed, '.1f')} s écoulées, "
+          f"{format_spec(_children_cpu() - cpu, '.1f')} s CPU, charge moyenne {format_spec(os.getloadavg()[0], '.1f')} "
+          f"sur {format_spec(os.cpu_count() or 1, 'd')} cœurs")
     return elapsed
 
 
@@ -51,9 +53,10 @@ def main() -> None:
             kc.figures.draw(name)
             elapsed = time.perf_counter() - start
             total += elapsed
-            print(f"{name:32s} {elapsed:6.2f} s ({time.process_time() - cpu:5.2f} s CPU)")
+            print(f"{name:32s} {format_spec(elapsed, '.2f'):>6s} s "
+                  f"({format_spec(time.process_time() - cpu, '.2f'):>5s} s CPU)")
     n = len(kc.figures.names())
-    print(f"{'calcul et tracé (sans écriture)':32s} {total:6.2f} s")
+    print(f"{'calcul et tracé (sans écriture)':32s} {format_spec(total, '.2f'):>6s} s")
     cores = os.cpu_count() or 1
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -62,10 +65,13 @@ def main() -> None:
         formats = timed_command(tmp / "formats", "--jobs", "0", "--format", "png,svg,pdf")
         same = all(filecmp.cmp(tmp / "serie" / f"{name}.png", tmp / "parallele" / f"{name}.png", shallow=False)
                    for name in kc.figures.names())
-    print(f"commande complète, {n} figures PNG, 1 processus : {serial:5.1f} s")
-    print(f"commande complète, {n} figures PNG, --jobs 0 ({cores} cœurs) : {parallel:5.1f} s "
-          f"(cible : < {TARGET_S:.0f} s, rapport {parallel / TARGET_S:.2f} ; accélération ×{serial / parallel:.2f})")
-    print(f"commande complète, {n} figures × 3 formats, --jobs 0 : {formats:5.1f} s")
+    n_text = format_spec(n, "d")
+    print(f"commande complète, {n_text} figures PNG, 1 processus : {format_spec(serial, '.1f'):>5s} s")
+    print(f"commande complète, {n_text} figures PNG, --jobs 0 ({format_spec(cores, 'd')} cœurs) : "
+          f"{format_spec(parallel, '.1f'):>5s} s (cible : < {format_spec(TARGET_S, '.0f')} s, "
+          f"rapport {format_spec(parallel / TARGET_S, '.2f')} ; "
+          f"accélération ×{format_spec(serial / parallel, '.2f')})")
+    print(f"commande complète, {n_text} figures × 3 formats, --jobs 0 : {format_spec(formats, '.1f'):>5s} s")
     print(f"PNG identiques octet pour octet (1 processus contre --jobs 0) : {'oui' if same else 'NON'}")
 
 

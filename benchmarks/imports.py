@@ -12,6 +12,8 @@ import statistics
 import subprocess
 import sys
 
+from kalman_course.numbers import format_spec  # dans ce processus seulement : la mesure est faite ailleurs
+
 CODE = """
 import time
 t0 = time.perf_counter()
@@ -30,8 +32,9 @@ def main(repeats: int = 7) -> None:
         base.append(float(out[0]))
         extra.append(float(out[1]))
     b, e = statistics.median(base), statistics.median(extra)
-    print(f"numpy + scipy (linalg, stats) : {b:.3f} s (médiane de {repeats})")
-    print(f"import kalman_course en plus  : {e:.3f} s (cible < 0,3 s) — {'atteinte' if e < 0.3 else 'MANQUÉE'}")
+    print(f"numpy + scipy (linalg, stats) : {format_spec(b, '.3f')} s (médiane de {format_spec(repeats, 'd')})")
+    print(f"import kalman_course en plus  : {format_spec(e, '.3f')} s (cible < {format_spec(0.3, '.1f')} s) — "
+          f"{'atteinte' if e < 0.3 else 'MANQUÉE'}")
 
 
 if __name__ == "__main__":

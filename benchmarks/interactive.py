@@ -25,6 +25,7 @@ from urllib.parse import urlsplit
 
 import kalman_course.interactive as ki
 from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
+from kalman_course.numbers import format_spec
 
 CHROMIUM_ARGS = [
     "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -61,10 +62,12 @@ def bench_grids() -> None:
     t = best_time(ki.voltage_grid)
     g = ki.voltage_grid()
     n = g.shape[0] * g.shape[1]
-    print(f"   tension constante  {g.shape[0]}×{g.shape[1]} exécutions × {g.time.size} pas : {t * 1e3:7.1f} ms"
-          f"  (objectif < 1000 ms : {'atteint' if t < 1 else 'MANQUÉ'}, {t / n * 1e6:.0f} µs par exécution)")
+    print(f"   tension constante  {format_spec(g.shape[0], 'd')}×{format_spec(g.shape[1], 'd')} exécutions × "
+          f"{format_spec(g.time.size, 'd')} pas : {format_spec(t * 1e3, '.1f'):>7s} ms"
+          f"  (objectif < {format_spec(1000, 'd')} ms : {'atteint' if t < 1 else 'MANQUÉ'}, "
+          f"{format_spec(t / n * 1e6, '.0f')} µs par exécution)")
     t = best_time(lambda: ki.voltage_sliders().html(), repeat=3)
-    print(f"   figure Bokeh complète de la tension (grille + document + HTML) : {t * 1e3:7.1f} ms")
+    print(f"   figure Bokeh complète de la tension (grille + document + HTML) : {format_spec(t * 1e3, '.1f'):>7s} ms")
     print("   figures à curseurs du registre (une exécution : grille + document + HTML) :")
     for name in ki.slider_names():
         spec_factory = ki.SLIDER_FIGURES[name][1]
@@ -74,9 +77,9 @@ def bench_grids() -> None:
         t1 = time.perf_counter()
         html = spec.static().html()
         t2 = time.perf_counter()
-        sizes = " × ".join(map(str, grid.shape))
-        print(f"     {name:28s} {sizes:>8s} points : grille {t1 - t0:6.2f} s, figure {1e3 * (t2 - t1):6.0f} ms, "
-              f"HTML {len(html) / 1e3:5.0f} ko")
+        sizes = " × ".join(format_spec(size, "d") for size in grid.shape)
+        print(f"     {name:28s} {sizes:>8s} points : grille {format_spec(t1 - t0, '.2f'):>6s} s, "
+              f"figure {format_spec(1e3 * (t2 - t1), '.0f'):>6s} ms, HTML {format_spec(len(html) / 1e3, '.0f'):>5s} ko")
 
 
 def serve(root: Path):
@@ -175,15 +178,18 @@ def bench_browser(root: Path, moves: int) -> None:
                 if MARKER in html_file.read_text():
                     target = f"  (objectif < 1 Mo : {'atteint' if own < 1e6 else 'MANQUÉ'})"
                 print(f"   {rel}")
-                print(f"     propre : HTML {w['html'] / 1e3:6.0f} ko + données {w['data'] / 1e3:6.0f} ko + images "
-                      f"{w['images'] / 1e3:6.0f} ko = {own / 1e6:.3f} Mo{target}")
-                print(f"     partagé : BokehJS {w['bokeh'] / 1e6:.3f} Mo, MathJax {w['mathjax'] / 1e6:.3f} Mo, "
-                      f"thème {w['theme'] / 1e6:.3f} Mo ; total chargé {(own + shared) / 1e6:.3f} Mo")
+                ko = {key: format_spec(w[key] / 1e3, ".0f") for key in ("html", "data", "images")}
+                mo = {key: format_spec(w[key] / 1e6, ".3f") for key in ("bokeh", "mathjax", "theme")}
+                print(f"     propre : HTML {ko['html']:>6s} ko + données {ko['data']:>6s} ko + images "
+                      f"{ko['images']:>6s} ko = {format_spec(own / 1e6, '.3f')} Mo{target}")
+                print(f"     partagé : BokehJS {mo['bokeh']} Mo, MathJax {mo['mathjax']} Mo, "
+                      f"thème {mo['theme']} Mo ; total chargé {format_spec((own + shared) / 1e6, '.3f')} Mo")
                 if blocked:
                     print(f"     REQUÊTES NON LOCALES BLOQUÉES : {blocked}")
                 page.close()
 
-            print(f"\n3. Réponse des curseurs dans Chromium headless ({moves} déplacements au clavier par curseur)")
+            print(f"\n3. Réponse des curseurs dans Chromium headless "
+                  f"({format_spec(moves, 'd')} déplacements au clavier par curseur)")
             for rel in PAGES:
                 html_file = root / rel
                 if not html_file.is_file() or MARKER not in html_file.read_text():
@@ -218,12 +224,15 @@ def bench_browser(root: Path, moves: int) -> None:
                         label = page.evaluate(f"() => Bokeh.documents[{k}].get_model_by_name('kc-slider-{s}').title")
                         med, p90 = statistics.median(paint_ms), statistics.quantiles(paint_ms, n=10)[-1]
                         worst = max(paint_ms)
-                        verdict = "atteint" if worst < 50 else ("atteint pour 90 % des mouvements" if p90 < 50
+                        ninety = format_spec(0.9, ".0%")
+                        verdict = "atteint" if worst < 50 else (f"atteint pour {ninety} des mouvements" if p90 < 50
                                                                else "MANQUÉ")
-                        print(f"   {name}, « {label} » ({len(done)} mouvements) :\n"
-                              f"     données recopiées : médiane {statistics.median(data_ms):5.1f} ms, "
-                              f"max {max(data_ms):5.1f} ms\n"
-                              f"     figure redessinée : médiane {med:5.1f} ms, 90 % {p90:5.1f} ms, max {worst:5.1f} ms"
+                        data_med = format_spec(statistics.median(data_ms), ".1f")
+                        print(f"   {name}, « {label} » ({format_spec(len(done), 'd')} mouvements) :\n"
+                              f"     données recopiées : médiane {data_med:>5s} ms, "
+                              f"max {format_spec(max(data_ms), '.1f'):>5s} ms\n"
+                              f"     figure redessinée : médiane {format_spec(med, '.1f'):>5s} ms, "
+                              f"{ninety} {format_spec(p90, '.1f'):>5s} ms, max {format_spec(worst, '.1f'):>5s} ms"
                               f" — objectif < 50 ms : {verdict}")
                 page.close()
             browser.close()
@@ -235,7 +244,8 @@ def load_note() -> str:
     try:
         import os
 
-        return f"charge moyenne de la machine (1 min) : {os.getloadavg()[0]:.2f} pour {os.cpu_count()} cœurs"
+        return (f"charge moyenne de la machine (1 min) : {format_spec(os.getloadavg()[0], '.2f')} "
+                f"pour {format_spec(os.cpu_count() or 1, 'd')} cœurs")
     except OSError:
         return ""
 

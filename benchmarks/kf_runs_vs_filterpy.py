@@ -2,7 +2,7 @@
 
 1000 tirages × 100 pas d'un modèle à 4 états et 2 mesures (vitesse constante dans le plan, position
 mesurée). Cible (issue « Un seul moteur ») : au moins 100 fois plus rapide que la boucle
-``predict()``/``update()`` de filterpy, pour les mêmes nombres (vérifiés ici à 1e-10).
+``predict()``/``update()`` de filterpy, pour les mêmes nombres (vérifiés ici à 10⁻¹⁰ près).
 
 Usage : .venv/bin/python benchmarks/kf_runs_vs_filterpy.py [--runs 1000] [--steps 100]
 """
@@ -16,6 +16,7 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 import kalman_course as kc
+from kalman_course.numbers import format_spec
 
 TARGET = 100.0
 
@@ -62,11 +63,12 @@ def main() -> None:
         best = min(best, time.perf_counter() - t0)
     err = float(np.max(np.abs(runs.x - ref)))
     ratio = t_fp / best
-    print(f"{args.runs} tirages × {args.steps} pas, 4 états, 2 mesures")
-    print(f"filterpy (boucle sur les tirages) : {t_fp:.3f} s")
-    print(f"kalman_filter_runs (lot)          : {1e3 * best:.2f} ms (meilleur de 5)")
-    print(f"rapport : {ratio:.0f} × plus rapide (cible ≥ {TARGET:.0f} ×) — {'atteinte' if ratio >= TARGET else 'MANQUÉE'}")
-    print(f"écart maximal des estimations : {err:.1e}")
+    print(f"{format_spec(args.runs, 'd')} tirages × {format_spec(args.steps, 'd')} pas, 4 états, 2 mesures")
+    print(f"filterpy (boucle sur les tirages) : {format_spec(t_fp, '.3f')} s")
+    print(f"kalman_filter_runs (lot)          : {format_spec(1e3 * best, '.2f')} ms (meilleur de 5)")
+    print(f"rapport : {format_spec(ratio, '.0f')} × plus rapide (cible ≥ {format_spec(TARGET, '.0f')} ×) — "
+          f"{'atteinte' if ratio >= TARGET else 'MANQUÉE'}")
+    print(f"écart maximal des estimations : {format_spec(err, '.1e' if err else 'd')}")
     if err > 1e-10:
         raise SystemExit("Les estimations diffèrent de filterpy.")
 

@@ -14,6 +14,7 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 import kalman_course as kc
+from kalman_course.numbers import format_spec
 from _timing import best_time
 
 TARGET = 0.8
@@ -39,10 +40,11 @@ def bench(label, model, y, x0, P0, repeat):
     diff = max(np.abs(res.x[-1] - x_fp).max(), np.abs(res.P[-1] - P_fp).max())
     ratio = t_ours / t_fp
     status = "OK" if ratio <= TARGET else "AU-DESSUS DE LA CIBLE"
+    us_ours, us_fp = format_spec(t_ours / T * 1e6, ".2f"), format_spec(t_fp / T * 1e6, ".2f")
     print(
-        f"{label:42s} {T:7d} pas  kalman_course {t_ours / T * 1e6:6.2f} µs/pas  "
-        f"filterpy {t_fp / T * 1e6:6.2f} µs/pas  rapport {ratio:4.2f} (cible ≤ {TARGET})  {status}  "
-        f"|écart final| {diff:.1e}"
+        f"{label:42s} {format_spec(T, 'd'):>7s} pas  kalman_course {us_ours:>6s} µs/pas  "
+        f"filterpy {us_fp:>6s} µs/pas  rapport {format_spec(ratio, '.2f'):>4s} "
+        f"(cible ≤ {format_spec(TARGET, 'g')})  {status}  |écart final| {format_spec(diff, '.1e' if diff else 'd')}"
     )
     return ratio
 

@@ -109,6 +109,9 @@ def main() -> None:
     if args.measure:
         measure(args.repeat, args.measure)
         return
+    # ici seulement : le processus de mesure (--measure) peut charger un autre exemplaire du paquet
+    from kalman_course.numbers import format_spec
+
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     with tempfile.TemporaryDirectory() as tmp:
         new_t = _run(here, args.repeat, os.path.join(tmp, "new.npz"))
@@ -116,17 +119,19 @@ def main() -> None:
         new = np.load(os.path.join(tmp, "new.npz"))
         ref = np.load(os.path.join(tmp, "ref.npz")) if args.reference else None
         for label in EXPERIMENTS:
-            line = f"{label:32s} {new_t[label]:6.3f} s CPU"
+            line = f"{label:32s} {format_spec(new_t[label], '.3f'):>6s} s CPU"
             if ref is not None:
                 keys = [k for k in ref.files if k.startswith(label + "|")]
                 dev = max((_deviation(ref[k], new[k]) for k in keys), default=0.0)
-                line += (f"   référence {ref_t[label]:6.3f} s   rapport {ref_t[label] / new_t[label]:4.1f}   "
-                         f"écart relatif max {dev:.1e}")
-            print(line.replace(".", ","))
+                line += (f"   référence {format_spec(ref_t[label], '.3f'):>6s} s   "
+                         f"rapport {format_spec(ref_t[label] / new_t[label], '.1f'):>4s}   "
+                         f"écart relatif max {format_spec(dev, '.1e' if dev else 'd')}")
+            print(line)
         if ref_t is not None:
             chapter = [k for k in EXPERIMENTS if not k.startswith(("particle", "ensemble", "growth"))]
             a, b = sum(ref_t[k] for k in chapter), sum(new_t[k] for k in chapter)
-            print(f"chapitre « vraisemblance » (calculs) : {a:.2f} s → {b:.2f} s, rapport {a / b:.1f}".replace(".", ","))
+            print(f"chapitre « vraisemblance » (calculs) : {format_spec(a, '.2f')} s → {format_spec(b, '.2f')} s, "
+                  f"rapport {format_spec(a / b, '.1f')}")
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ import numpy as np
 import statsmodels.api as sm
 
 import kalman_course as kc
+from kalman_course.numbers import format_spec
 from kalman_course.scenarios.nile import local_level_from_log
 from _timing import best_time
 
@@ -45,17 +46,23 @@ def main() -> None:
     # hessienne (ses points sont évalués en lot) prend le reste
     t_ours_opt = min(t_ours, ours.n_evaluations * t_one)
     var = np.exp(ours.theta)
-    print(f"statsmodels   : {t_sm * 1e3:8.1f} ms  σ²_ε = {ref.params[0]:9.1f}  σ²_η = {ref.params[1]:7.1f}  "
-          f"log L = {ref.llf:.6f}  ({ref.mle_retvals.get('fcalls', '?')} évaluations)")
-    print(f"kalman_course : {t_ours * 1e3:8.1f} ms  σ²_ε = {var[0]:9.1f}  σ²_η = {var[1]:7.1f}  "
-          f"log L = {ours.log_likelihood:.6f}  ({ours.n_evaluations} évaluations pour BFGS, {calls[0]} au total "
-          "avec la hessienne)")
-    print(f"une vraisemblance : kalman_course {t_one * 1e3:.2f} ms, statsmodels {t_sm_one * 1e3:.2f} ms, "
-          f"rapport {t_one / t_sm_one:.1f}")
-    print(f"rapport des temps (kalman_course / statsmodels) : {t_ours / t_sm:.1f} avec la hessienne, "
-          f"≈ {t_ours_opt / t_sm:.1f} sans (hessienne ≈ {(t_ours - t_ours_opt) * 1e3:.0f} ms)")
-    print(f"écart de log L : {ours.log_likelihood - ref.llf:+.2e} ; écarts relatifs des variances : "
-          f"{100 * (var[0] / ref.params[0] - 1):+.2f} %, {100 * (var[1] / ref.params[1] - 1):+.2f} %")
+    fcalls = ref.mle_retvals.get("fcalls")
+    sm_calls = "?" if fcalls is None else format_spec(fcalls, "d")
+    print(f"statsmodels   : {format_spec(t_sm * 1e3, '.1f'):>8s} ms  "
+          f"σ²_ε = {format_spec(ref.params[0], '.1f'):>9s}  σ²_η = {format_spec(ref.params[1], '.1f'):>7s}  "
+          f"log L = {format_spec(ref.llf, '.6f')}  ({sm_calls} évaluations)")
+    print(f"kalman_course : {format_spec(t_ours * 1e3, '.1f'):>8s} ms  "
+          f"σ²_ε = {format_spec(var[0], '.1f'):>9s}  σ²_η = {format_spec(var[1], '.1f'):>7s}  "
+          f"log L = {format_spec(ours.log_likelihood, '.6f')}  ({format_spec(ours.n_evaluations, 'd')} évaluations "
+          f"pour BFGS, {format_spec(calls[0], 'd')} au total avec la hessienne)")
+    print(f"une vraisemblance : kalman_course {format_spec(t_one * 1e3, '.2f')} ms, "
+          f"statsmodels {format_spec(t_sm_one * 1e3, '.2f')} ms, rapport {format_spec(t_one / t_sm_one, '.1f')}")
+    print(f"rapport des temps (kalman_course / statsmodels) : {format_spec(t_ours / t_sm, '.1f')} avec la hessienne, "
+          f"≈ {format_spec(t_ours_opt / t_sm, '.1f')} sans "
+          f"(hessienne ≈ {format_spec((t_ours - t_ours_opt) * 1e3, '.0f')} ms)")
+    print(f"écart de log L : {format_spec(ours.log_likelihood - ref.llf, '+.2e')} ; écarts relatifs des variances : "
+          f"{format_spec(100 * (var[0] / ref.params[0] - 1), '+.2f')}\u202f%, "
+          f"{format_spec(100 * (var[1] / ref.params[1] - 1), '+.2f')}\u202f%")  # « +.2% » perdrait le signe +
 
 
 if __name__ == "__main__":

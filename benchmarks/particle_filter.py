@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import kalman_course as kc
+from kalman_course.numbers import format_spec
 from kalman_course.scenarios import pendulum
 from _timing import best_time
 
@@ -69,19 +70,21 @@ def main() -> None:
     gap = np.abs(res.x - m_np).max()
     ok1 = "OK" if ratio <= TARGET_RATIO else "AU-DESSUS DE LA CIBLE"
     ok2 = "OK" if t_pkg < TARGET_SECONDS else "AU-DESSUS DE LA CIBLE"
-    print(f"pendule, {N} particules × {len(data.y)} pas (modèle vectorisé) :")
-    print(f"  particle_filter            {t_pkg:7.3f} s   (cible < {TARGET_SECONDS} s)  {ok2}")
-    print(f"  boucle numpy nue           {t_np:7.3f} s")
-    print(f"  rapport                    {ratio:7.2f}     (cible ≤ {TARGET_RATIO})  {ok1}")
-    print(f"  |écart des moyennes| max   {gap:.2e} rad (erreur de Monte-Carlo, tirages différents)")
+    print(f"pendule, {format_spec(N, 'd')} particules × {format_spec(len(data.y), 'd')} pas (modèle vectorisé) :")
+    print(f"  particle_filter            {format_spec(t_pkg, '.3f'):>7s} s   "
+          f"(cible < {format_spec(TARGET_SECONDS, 'g')} s)  {ok2}")
+    print(f"  boucle numpy nue           {format_spec(t_np, '.3f'):>7s} s")
+    print(f"  rapport                    {format_spec(ratio, '.2f'):>7s}     "
+          f"(cible ≤ {format_spec(TARGET_RATIO, 'g')})  {ok1}")
+    print(f"  |écart des moyennes| max   {format_spec(gap, '.2e')} rad (erreur de Monte-Carlo, tirages différents)")
 
     slow = pendulum.pendulum_model(vectorized=False)
     n_slow = 1000
     t_slow, _ = best_time(lambda: kc.particle_filter(slow, data.y, data.x0, data.P0, n_particles=n_slow, rng=1), 1)
     t_fast, _ = best_time(lambda: kc.particle_filter(model, data.y, data.x0, data.P0, n_particles=n_slow, rng=1),
                           args.repeat)
-    print(f"  {n_slow} particules, modèle non vectorisé : {t_slow:.3f} s ; vectorisé : {t_fast:.3f} s "
-          f"(gain {t_slow / t_fast:.0f} ×)")
+    print(f"  {format_spec(n_slow, 'd')} particules, modèle non vectorisé : {format_spec(t_slow, '.3f')} s ; "
+          f"vectorisé : {format_spec(t_fast, '.3f')} s (gain {format_spec(t_slow / t_fast, '.0f')} ×)")
 
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
     from reference_ukf import filterpy_unscented_filter
@@ -92,11 +95,12 @@ def main() -> None:
     t_fp, _ = best_time(lambda: filterpy_unscented_filter(model, long.y, long.x0, long.P0, alpha=1.0, kappa=0.0),
                         args.repeat)
     T = len(long.y)
-    print(f"UKF, pendule, {T} pas : paquet {t_ukf / T * 1e6:6.1f} µs/pas, filterpy {t_fp / T * 1e6:6.1f} µs/pas "
-          f"(rapport {t_ukf / t_fp:.2f})")
+    print(f"UKF, pendule, {format_spec(T, 'd')} pas : paquet {format_spec(t_ukf / T * 1e6, '.1f'):>6s} µs/pas, "
+          f"filterpy {format_spec(t_fp / T * 1e6, '.1f'):>6s} µs/pas (rapport {format_spec(t_ukf / t_fp, '.2f')})")
     t_enkf, _ = best_time(lambda: kc.ensemble_kalman_filter(model, long.y, long.x0, long.P0, n_members=1000, rng=1),
                           args.repeat)
-    print(f"EnKF, pendule, 1000 membres × {T} pas : {t_enkf:.3f} s")
+    print(f"EnKF, pendule, {format_spec(1000, 'd')} membres × {format_spec(T, 'd')} pas : "
+          f"{format_spec(t_enkf, '.3f')} s")
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 import kalman_course as kc
+from kalman_course.numbers import format_spec
 from _timing import best_time
 
 
@@ -27,8 +28,10 @@ def bench(label, model, y, x0, P0, repeat):
     t_ours, ours = best_time(lambda: kc.rts_smoother(model, result), repeat)
     t_fp, (xs, Ps, _, _) = best_time(lambda: kf.rts_smoother(xs_in, Ps_in), repeat)
     diff = max(np.abs(ours.x - xs[:, :, 0]).max(), np.abs(ours.P - Ps).max())
-    print(f"{label:34s} {T:7d} pas  kalman_course {t_ours / T * 1e6:6.2f} µs/pas  "
-          f"filterpy {t_fp / T * 1e6:6.2f} µs/pas  rapport {t_ours / t_fp:4.2f}  |écart| {diff:.1e}")
+    us_ours, us_fp = format_spec(t_ours / T * 1e6, ".2f"), format_spec(t_fp / T * 1e6, ".2f")
+    print(f"{label:34s} {format_spec(T, 'd'):>7s} pas  kalman_course {us_ours:>6s} µs/pas  "
+          f"filterpy {us_fp:>6s} µs/pas  rapport {format_spec(t_ours / t_fp, '.2f'):>4s}  "
+          f"|écart| {format_spec(diff, '.1e' if diff else 'd')}")
 
 
 def main() -> None:
