@@ -32,7 +32,7 @@ MAX_GAP = 1e-9
 
 def fr_sci(value: float) -> str:
     """Petit écart en notation scientifique française (« 2,3 × 10⁻¹³ ») ; un écart nul s'écrit « 0 »."""
-    return format_spec(value, ".1e" if value != 0 else "d")
+    return format_spec(value, ".1e")
 
 
 def best_cpu(func: Callable[[], Any]) -> tuple[float, Any]:

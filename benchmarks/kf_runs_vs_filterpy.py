@@ -68,7 +68,7 @@ def main() -> None:
     print(f"kalman_filter_runs (lot)          : {format_spec(1e3 * best, '.2f')} ms (meilleur de 5)")
     print(f"rapport : {format_spec(ratio, '.0f')} × plus rapide (cible ≥ {format_spec(TARGET, '.0f')} ×) — "
           f"{'atteinte' if ratio >= TARGET else 'MANQUÉE'}")
-    print(f"écart maximal des estimations : {format_spec(err, '.1e' if err else 'd')}")
+    print(f"écart maximal des estimations : {format_spec(err, '.1e')}")
     if err > 1e-10:
         raise SystemExit("Les estimations diffèrent de filterpy.")
 

@@ -44,7 +44,7 @@ def bench(label, model, y, x0, P0, repeat):
     print(
         f"{label:42s} {format_spec(T, 'd'):>7s} pas  kalman_course {us_ours:>6s} µs/pas  "
         f"filterpy {us_fp:>6s} µs/pas  rapport {format_spec(ratio, '.2f'):>4s} "
-        f"(cible ≤ {format_spec(TARGET, 'g')})  {status}  |écart final| {format_spec(diff, '.1e' if diff else 'd')}"
+        f"(cible ≤ {format_spec(TARGET, 'g')})  {status}  |écart final| {format_spec(diff, '.1e')}"
     )
     return ratio
 

@@ -125,7 +125,7 @@ def main() -> None:
                 dev = max((_deviation(ref[k], new[k]) for k in keys), default=0.0)
                 line += (f"   référence {format_spec(ref_t[label], '.3f'):>6s} s   "
                          f"rapport {format_spec(ref_t[label] / new_t[label], '.1f'):>4s}   "
-                         f"écart relatif max {format_spec(dev, '.1e' if dev else 'd')}")
+                         f"écart relatif max {format_spec(dev, '.1e')}")
             print(line)
         if ref_t is not None:
             chapter = [k for k in EXPERIMENTS if not k.startswith(("particle", "ensemble", "growth"))]

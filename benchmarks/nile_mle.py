@@ -61,8 +61,7 @@ def main() -> None:
           f"≈ {format_spec(t_ours_opt / t_sm, '.1f')} sans "
           f"(hessienne ≈ {format_spec((t_ours - t_ours_opt) * 1e3, '.0f')} ms)")
     print(f"écart de log L : {format_spec(ours.log_likelihood - ref.llf, '+.2e')} ; écarts relatifs des variances : "
-          f"{format_spec(100 * (var[0] / ref.params[0] - 1), '+.2f')}\u202f%, "
-          f"{format_spec(100 * (var[1] / ref.params[1] - 1), '+.2f')}\u202f%")  # « +.2% » perdrait le signe +
+          f"{format_spec(var[0] / ref.params[0] - 1, '+.2%')}, {format_spec(var[1] / ref.params[1] - 1, '+.2%')}")
 
 
 if __name__ == "__main__":

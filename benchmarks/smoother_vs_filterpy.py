@@ -31,7 +31,7 @@ def bench(label, model, y, x0, P0, repeat):
     us_ours, us_fp = format_spec(t_ours / T * 1e6, ".2f"), format_spec(t_fp / T * 1e6, ".2f")
     print(f"{label:34s} {format_spec(T, 'd'):>7s} pas  kalman_course {us_ours:>6s} µs/pas  "
           f"filterpy {us_fp:>6s} µs/pas  rapport {format_spec(t_ours / t_fp, '.2f'):>4s}  "
-          f"|écart| {format_spec(diff, '.1e' if diff else 'd')}")
+          f"|écart| {format_spec(diff, '.1e')}")
 
 
 def main() -> None:

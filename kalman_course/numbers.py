@@ -93,7 +93,7 @@ def format_number(
     (``None``), choisie avec ``significant`` quand :math:`|x| < 10^{-3}` ou :math:`|x| \ge 10^{6}`.
     ``unit`` : unité ajoutée après une espace insécable (« 0,08 m ») ; le degré d'angle est collé (« 20° »). ``trim`` : retire les zéros
     inutiles en fin de partie décimale (« 0,5 » plutôt que « 0,500 », comme le format ``g`` de Python).
-    NaN s'écrit « NaN », l'infini « ∞ ».
+    NaN s'écrit « NaN », l'infini « ∞ », zéro en écriture scientifique « 0 ».
 
     Exemples : ``format_number(-0.5, decimals=2)`` → « −0,50 » ;
     ``format_number(2.5e-15, significant=2)`` → « 2,5 × 10⁻¹⁵ ».
@@ -121,7 +121,9 @@ def format_number(
         if rounded != 0:
             exponent = math.floor(math.log10(abs(rounded)))
         use_sci = scientific if scientific is not None else (x != 0 and (exponent < -3 or exponent >= 6))
-        if use_sci:
+        if use_sci and rounded == 0:  # zéro n'a pas d'ordre de grandeur : « 0 », jamais « 0,0 × 10⁰ »
+            text = "0"
+        elif use_sci:
             mantissa = rounded / 10.0**exponent
             text = _power_of_ten(_fixed(mantissa, sig - 1, group=False, trim=trim), exponent)
         else:
@@ -176,7 +178,7 @@ def format_spec(value: Any, spec: str) -> str:
     elif kind == "e":
         text = format_number(value, significant=7 if precision is None else precision + 1, scientific=True)
     elif kind == "%":
-        return format_percent(value, 6 if precision is None else precision)
+        text = format_percent(value, 6 if precision is None else precision)
     elif kind == "d":
         text = format_integer(value)
     else:
