@@ -2,7 +2,9 @@
 
 Cible : ``python -m kalman_course.figures --out DOSSIER`` (toutes les figures, PNG) en moins de 15 s sur
 la machine du cours (2 cœurs), en parallèle (``--jobs 0`` : un processus par cœur). Le script imprime
-aussi le temps en un seul processus et celui des trois formats (png, svg, pdf), et vérifie que deux
+aussi, figure par figure, le temps CPU du calcul et du tracé puis celui du rendu PNG (mise en page et
+dessin par matplotlib), le plancher de la commande sans aucun calcul (import, puis rendu réparti sur les
+cœurs), le temps en un seul processus et celui des trois formats (png, svg, pdf), et vérifie que deux
 régénérations écrivent les mêmes octets.
 Usage : ``python benchmarks/figures.py``.
 """
@@ -10,6 +12,7 @@ Usage : ``python benchmarks/figures.py``.
 from __future__ import annotations
 
 import filecmp
+import io
 import os
 import resource
 import subprocess
@@ -43,21 +46,40 @@ def timed_command(out: Path, *args: str) -> float:
     return elapsed
 
 
+def import_time(repeats: int = 3) -> float:
+    """Temps (s, le meilleur de ``repeats``) d'import de la commande dans un processus neuf : le processus
+    parent le paie seul, avant de créer les processus qui dessinent."""
+    code = ("import time; t = time.perf_counter(); import kalman_course.figures.__main__; "
+            "print(time.perf_counter() - t)")
+    return min(float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout)
+               for _ in range(repeats))
+
+
 def main() -> None:
     from threadpoolctl import threadpool_limits
 
-    total = 0.0
+    from kalman_course.figures.__main__ import _SAVE_OPTIONS, _warm_up
+
+    _warm_up()
+    total = render = 0.0
+    print(f"{'figure':32s} {'calcul et tracé':>17s} {'rendu PNG':>11s}")
     with threadpool_limits(limits=1, user_api="blas"):  # comme la commande (BLAS sur un fil)
         for name in kc.figures.names():
-            start, cpu = time.perf_counter(), time.process_time()
-            kc.figures.draw(name)
-            elapsed = time.perf_counter() - start
-            total += elapsed
-            print(f"{name:32s} {format_spec(elapsed, '.2f'):>6s} s "
-                  f"({format_spec(time.process_time() - cpu, '.2f'):>5s} s CPU)")
+            cpu = time.process_time()
+            fig = kc.figures.draw(name)
+            built = time.process_time() - cpu
+            cpu = time.process_time()
+            fig.savefig(io.BytesIO(), format="png", dpi=150, **_SAVE_OPTIONS["png"])  # mise en page et rendu
+            drawn = time.process_time() - cpu
+            total, render = total + built, render + drawn
+            print(f"{name:32s} {format_spec(built, '.2f'):>11s} s CPU {format_spec(drawn, '.2f'):>7s} s CPU")
     n = len(kc.figures.names())
-    print(f"{'calcul et tracé (sans écriture)':32s} {format_spec(total, '.2f'):>6s} s")
+    print(f"{'total':32s} {format_spec(total, '.2f'):>11s} s CPU {format_spec(render, '.2f'):>7s} s CPU")
     cores = os.cpu_count() or 1
+    imported = import_time()
+    floor = imported + render / cores
+    print(f"import du paquet et de matplotlib (processus neuf) : {format_spec(imported, '.2f')} s ; plancher de la "
+          f"commande sans aucun calcul, import + rendu / {format_spec(cores, 'd')} cœurs : {format_spec(floor, '.1f')} s")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         serial = timed_command(tmp / "serie", "--jobs", "1")
