@@ -28,6 +28,7 @@ import pytest
 
 import kalman_course.interactive as ki
 from kalman_course.book_typography import french_spacing
+from kalman_course.numbers import format_spec
 from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
 
 pytestmark = pytest.mark.browser
@@ -393,9 +394,9 @@ def test_static_sliders_show_the_package_runs(site, browser, capsys):
         with capsys.disabled():
             print(f"\nPoids de {html_file.relative_to(site.root)} :")
             for label, size in sizes.items():
-                print(f"  {label:38s} {size / 1e6:7.3f} Mo")
-            print(f"  {'propre au chapitre (HTML + données + images)':38s} {own / 1e6:7.3f} Mo")
-            print(f"  {'partagé par le site':38s} {shared / 1e6:7.3f} Mo")
+                print(f"  {label:38s} {format_spec(size / 1e6, '.3f'):>7s} Mo")
+            print(f"  {'propre au chapitre (HTML + données + images)':38s} {format_spec(own / 1e6, '.3f'):>7s} Mo")
+            print(f"  {'partagé par le site':38s} {format_spec(shared / 1e6, '.3f'):>7s} Mo")
         page.context.close()
 
 

@@ -8,6 +8,8 @@ import pytest
 import statsmodels.api as sm
 
 import kalman_course as kc
+from kalman_course.numbers import format_array
+from kalman_course.numbers import format_spec as fs
 from conftest import random_model
 from dense_oracle import batch_log_likelihood
 
@@ -61,7 +63,7 @@ def test_exact_diffuse_log_likelihood_equals_statsmodels_on_the_nile(trend, para
     y = kc.datasets.nile().flow
     ours = kc.log_likelihood(_nile_model(trend, params), y)
     ref = sm.tsa.UnobservedComponents(y, trend, use_exact_diffuse=True).loglike(params)
-    print(f"{trend} : ours {ours:.10f}  statsmodels {ref:.10f}  écart {ours - ref:.2e}")
+    print(f"{trend} : kalman_course {fs(ours, '.10f')}  statsmodels {fs(ref, '.10f')}  écart {fs(ours - ref, '.2e')}")
     assert abs(ours - ref) < 1e-6
     assert abs(ours - expected) < 1e-6
 
@@ -82,7 +84,7 @@ def test_statsmodels_default_start_is_only_approximately_diffuse():
     exact = kc.log_likelihood(_nile_model("llevel", NILE_LLEVEL), y)
     approx = sm.tsa.UnobservedComponents(y, "llevel").loglike(NILE_LLEVEL)
     gap = approx - (exact + 0.5 * np.log(2 * np.pi))
-    print(f"départ approché − (exact + ½ log 2π) = {gap:.4f}")
+    print(f"départ approché − (exact + ½ log 2π) = {fs(gap, '.4f')}")
     assert 1e-3 < abs(gap) < 0.05
 
 
@@ -96,7 +98,7 @@ def test_known_prior_log_likelihood_equals_statsmodels_initialize_known():
     mod.ssm.loglikelihood_burn = 0
     ref = mod.loglike(NILE_LLEVEL)
     ours = kc.log_likelihood(model, y, x0, P0)
-    print(f"a priori connu : ours {ours:.10f}  statsmodels {ref:.10f}")
+    print(f"a priori connu : kalman_course {fs(ours, '.10f')}  statsmodels {fs(ref, '.10f')}")
     assert abs(ours - ref) < 1e-7
 
 
@@ -216,10 +218,10 @@ def test_maximum_likelihood_reaches_statsmodels_maximum_on_the_nile(nile_mle):
     ours, ref = nile_mle
     var = np.exp(ours.theta)
     rel = var / ref.params - 1
-    print(f"\nMV du Nil : ours log L = {ours.log_likelihood:.6f}, statsmodels {ref.llf:.6f} "
-          f"(écart {ours.log_likelihood - ref.llf:+.2e})")
-    print(f"  σ²_ε = {var[0]:.1f} (statsmodels {ref.params[0]:.1f}, {100 * rel[0]:+.2f} %), "
-          f"σ²_η = {var[1]:.1f} (statsmodels {ref.params[1]:.1f}, {100 * rel[1]:+.2f} %)")
+    print(f"\nMV du Nil : kalman_course log L = {fs(ours.log_likelihood, '.6f')}, statsmodels {fs(ref.llf, '.6f')} "
+          f"(écart {fs(ours.log_likelihood - ref.llf, '+.2e')})")
+    print(f"  σ²_ε = {fs(var[0], '.1f')} (statsmodels {fs(ref.params[0], '.1f')}, {fs(rel[0], '+.2%')}), "
+          f"σ²_η = {fs(var[1], '.1f')} (statsmodels {fs(ref.params[1], '.1f')}, {fs(rel[1], '+.2%')})")
     assert ours.converged
     assert abs(ours.log_likelihood - ref.llf) < 1e-3
     assert ours.log_likelihood >= ref.llf - 1e-6  # pas moins bon que statsmodels
@@ -257,7 +259,8 @@ def test_standard_errors_agree_with_statsmodels_by_the_delta_method(nile_mle):
     hessienne numérique (``cov_params_approx``), en des optimums un peu différents (surface plate)."""
     se_var = np.exp(ours.theta) * ours.standard_errors  # σ² = e^θ : se(σ²) = σ² se(θ) au maximum
     se_ref = np.sqrt(np.diag(ref.cov_params_approx))
-    print(f"\nécarts-types de (σ²_ε, σ²_η) : ours {se_var.round(1)}, statsmodels (hessienne) {se_ref.round(1)}")
+    print(f"\nécarts-types de (σ²_ε, σ²_η) : kalman_course {format_array(se_var, decimals=1)}, "
+          f"statsmodels (hessienne) {format_array(se_ref, decimals=1)}")
     np.testing.assert_allclose(se_var, se_ref, rtol=0.05)
 
 
@@ -270,8 +273,8 @@ def test_em_never_decreases_and_reaches_the_maximum_likelihood(missing):
     em = kc.expectation_maximization(_nile_model("llevel", [10000.0, 1000.0]), y, max_iter=3000, tol=1e-12)
     mle = kc.maximum_likelihood(_local_level, y, np.log([10000.0, 1000.0]))
     steps = np.diff(em.history)
-    print(f"\nEM (manquantes : {missing}) : {em.n_iter} itérations, log L {em.log_likelihood:.8f}, "
-          f"MV {mle.log_likelihood:.8f} ; plus petit pas {steps.min():.2e}")
+    print(f"\nEM (manquantes : {'oui' if missing else 'non'}) : {fs(em.n_iter, 'd')} itérations, "
+          f"log L {fs(em.log_likelihood, '.8f')}, MV {fs(mle.log_likelihood, '.8f')} ; plus petit pas {fs(steps.min(), '.2e')}")
     assert (steps >= -1e-9).all()  # jamais de baisse (aux arrondis près)
     assert em.converged
     assert em.log_likelihood == pytest.approx(mle.log_likelihood, abs=1e-5)
@@ -299,8 +302,8 @@ def test_em_with_known_prior_and_partial_rows_reaches_the_maximum_likelihood():
     em = kc.expectation_maximization(start, y, x0, P0, max_iter=5000, tol=1e-13)
     assert (np.diff(em.history) >= -1e-9).all()
     mle = kc.maximum_likelihood(build, y, np.zeros(4), x0, P0)
-    print(f"\nEM (a priori connu, lignes partielles) : {em.n_iter} itérations, log L {em.log_likelihood:.8f}, "
-          f"MV {mle.log_likelihood:.8f}")
+    print(f"\nEM (a priori connu, lignes partielles) : {fs(em.n_iter, 'd')} itérations, "
+          f"log L {fs(em.log_likelihood, '.8f')}, MV {fs(mle.log_likelihood, '.8f')}")
     assert em.log_likelihood == pytest.approx(mle.log_likelihood, abs=1e-5)
     np.testing.assert_allclose(em.model.Q, mle.model.Q, rtol=5e-3)
     np.testing.assert_allclose(em.model.R, mle.model.R, rtol=5e-3, atol=5e-3)

@@ -27,6 +27,7 @@ import yaml
 from PIL import Image
 
 from conftest import BUILD_REPORT, ROOT, run_jupyter_book, tree_state
+from kalman_course.numbers import format_spec
 
 sys.path.insert(0, str(ROOT / "scripts"))
 from pdf import TARGET, compile_pdf  # noqa: E402
@@ -78,7 +79,7 @@ def pdf_build(book_build_dir):
     pdf, compile_s = compile_pdf(latex_dir, book_build_dir / "_build" / "pdf" / f"{TARGET}.pdf")
     total = time.perf_counter() - start
     BUILD_REPORT.append(f"PDF : {total:.0f} s au total, dont {compile_s:.0f} s de XeLaTeX (latexmk) → {pdf}")
-    print(f"\nPDF construit en {total:.0f} s (XeLaTeX : {compile_s:.0f} s) : {pdf}")
+    print(f"\nPDF construit en {format_spec(total, '.0f')} s (XeLaTeX : {format_spec(compile_s, '.0f')} s) : {pdf}")
     text = subprocess.run(["pdftotext", "-enc", "UTF-8", str(pdf), "-"], check=True, capture_output=True,
                           text=True).stdout
     info = subprocess.run(["pdfinfo", str(pdf)], check=True, capture_output=True, text=True).stdout
