@@ -51,7 +51,15 @@ import scipy.optimize
 from .core.linalg import S_NOT_PD, symmetrize
 from .core.models import LinearGaussianModel
 from .core.results import FilterResult, freeze
-from .core.validation import KalmanInputError, as_controls, as_float_array, as_measurements, check_instance, shape_text
+from .core.validation import (
+    KalmanInputError,
+    array_text,
+    as_controls,
+    as_float_array,
+    as_measurements,
+    check_instance,
+    shape_text,
+)
 from .filters.diffuse import (
     DiffuseFilterResult,
     diffuse_family,
@@ -346,16 +354,16 @@ def _call_build(build: Callable, theta: np.ndarray, where: str) -> LinearGaussia
     try:
         model = build(theta.copy())
     except KalmanInputError as exc:
-        raise KalmanInputError(f"« build » a refusé {where} = {np.array2string(theta, precision=6)} : {exc}") from exc
+        raise KalmanInputError(f"« build » a refusé {where} = {array_text(theta, significant=6, trim=True)} : {exc}") from exc
     except Exception as exc:  # noqa: BLE001 — l'erreur de l'utilisateur, rendue lisible
         raise KalmanInputError(
-            f"« build » a échoué pour {where} = {np.array2string(theta, precision=6)} ({type(exc).__name__}: {exc}) ; "
+            f"« build » a échoué pour {where} = {array_text(theta, significant=6, trim=True)} ({type(exc).__name__}: {exc}) ; "
             f"« {where} » a-t-il la bonne longueur ({theta.size}) ?"
         ) from exc
     if not isinstance(model, LinearGaussianModel):
         raise KalmanInputError(
             f"« build » doit renvoyer un LinearGaussianModel ; il a renvoyé {type(model).__name__} pour "
-            f"{where} = {np.array2string(theta, precision=6)}."
+            f"{where} = {array_text(theta, significant=6, trim=True)}."
         )
     return model
 

@@ -117,7 +117,7 @@ def test_oplus_ominus_round_trip():
     "T, message",
     [
         (np.diag([1.0, 1.0, 2.0, 1.0]), "n'est pas une transformation rigide.*rotation"),
-        (np.diag([1.0, 1.0, -1.0, 1.0]), "det = -1"),
+        (np.diag([1.0, 1.0, -1.0, 1.0]), "det = −1"),
         (np.vstack([np.eye(4)[:3], [0, 0, 1.0, 1.0]]), r"dernière ligne doit être \[0, 0, 0, 1\]"),
         (np.eye(3), r"transformation rigide \(4, 4\)"),
         (np.full((4, 4), np.nan), "non finies"),

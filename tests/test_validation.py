@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -37,7 +39,7 @@ def model2(**over):
         (dict(A=[[1.0, np.nan], [0.0, 1.0]]), r"« A » contient des valeurs non finies"),
         (dict(Q=[[np.inf, 0], [0, 1.0]]), r"« Q » contient des valeurs non finies"),
         (dict(Q=[[1.0, 0.5], [0.0, 1.0]]), r"« Q » doit être symétrique"),
-        (dict(Q=[[1.0, 0.0], [0.0, -0.1]]), r"« Q » doit être semi-définie positive .* -0\.1"),
+        (dict(Q=[[1.0, 0.0], [0.0, -0.1]]), "« Q » doit être semi-définie positive .* −0,1"),
         (dict(R=[[0.0]]), r"« R » doit être définie positive"),
         (dict(R=[[-1.0]]), r"« R » doit être définie positive"),
         (dict(A=[["a", "b"], ["c", "d"]]), r"« A » doit être un tableau de nombres réels"),
@@ -241,3 +243,36 @@ def test_se3_filter_with_zero_prior_and_noise_runs_instead_of_blaming_P_pred():
     res = kc.se3_iterated_filter(y, T0, np.zeros((6, 6)), ct.TARGET_POINTS, ct.CAMERA, 1.0, u=U)
     np.testing.assert_allclose(res.P, 0.0, atol=1e-12)  # aucune incertitude : les mesures ne corrigent rien
     np.testing.assert_allclose(res.T[-1], T0 @ kc.se3_exp(U[0]) @ kc.se3_exp(U[1]) @ kc.se3_exp(U[2]), atol=1e-12)
+
+
+def _camera_behind():
+    from kalman_course.geometry.camera import PinholeCamera, project
+
+    return project(PinholeCamera(fx=500.0, fy=500.0, cx=320.0, cy=240.0), [[0.0, 0.0, -9.75]])
+
+
+@pytest.mark.parametrize(
+    "call, number",
+    [
+        (lambda: kc.kalman_filter(model2(), np.zeros(3), np.zeros(2), [[1.0, 0.0], [0.0, -0.00125]]), "−0,00125"),
+        (lambda: model2(Q=[[0.01, 0.0], [0.25, 0.01]]), "0,25"),
+        (lambda: kc.unscented_kalman_filter(kc.NonlinearModel.from_linear(model2()), np.zeros(3), np.zeros(2),
+                                            [[1.0, 0.0], [0.0, -0.5]], alpha=1.0, kappa=0.0), "−0,5"),
+        (lambda: kc.lie.as_rotation("R", np.diag([1.0, 1.0, 1.5])), "det R = 1,5"),
+        (lambda: kc.lie.as_pose("T", np.vstack([np.eye(4)[:3], [0.125, 0.0, 0.0, 1.0]])), "[0,1250  0,0000"),
+        (lambda: kc.square_root_information_filter(model2(), np.zeros(3), None, None, R0=[[1.0, 0.0], [0.5, 1.0]],
+                                                      z0=np.zeros(2)),
+         "0,5"),
+        (_camera_behind, "Z' = −9,75 m"),
+        (lambda: kc.measurement_initialisation(
+            kc.LinearGaussianModel(np.eye(2), [[1.0, 1.0], [1.0, 1.0]], np.eye(2), np.eye(2)), [1.0, 1.0]), "∞"),
+    ],
+)
+def test_numbers_in_error_messages_are_written_the_french_way(call, number):
+    """Un nombre cité par un message d'erreur suit l'écriture française (virgule décimale, signe moins,
+    « ∞ ») : kalman_course.numbers.format_spec, pas le format de Python."""
+    with pytest.raises(KalmanInputError) as err:
+        call()
+    message = str(err.value)
+    assert number in message, message
+    assert not re.search(r"\d\.\d|e[+-]\d\d|(?<![\w−])-\d|\binf\b", message), message

@@ -142,6 +142,23 @@ def as_square_matrix(name: str, value: Any, n: int | None) -> np.ndarray:
     return arr
 
 
+def number_text(value: Any, spec: str) -> str:
+    """Un nombre cité dans un message d'erreur, écrit à la française (« −1,23 × 10⁻³ ») par
+    :func:`kalman_course.numbers.format_spec` ; importé ici seulement : Babel ne se charge que si une
+    erreur est levée."""
+    from ..numbers import format_spec
+
+    return format_spec(value, spec)
+
+
+def array_text(value: Any, **options: Any) -> str:
+    """Un vecteur cité dans un message d'erreur, écrit à la française par
+    :func:`kalman_course.numbers.format_array` (``options`` : ``decimals`` ou ``significant``…)."""
+    from ..numbers import format_array
+
+    return format_array(value, **options)
+
+
 def symmetric_tolerance(M: np.ndarray) -> float:
     """Tolérance relative de symétrie : ``1e-9 · max(1, max|M|)``."""
     return 1e-9 * max(1.0, float(np.max(np.abs(M))) if M.size else 1.0)
@@ -153,7 +170,7 @@ def check_symmetric(name: str, M: np.ndarray) -> np.ndarray:
     if asym > symmetric_tolerance(M):
         raise KalmanInputError(
             f"« {name} » doit être symétrique (c'est une matrice de covariance) ; "
-            f"écart maximal |{name} − {name}ᵀ| = {asym:.3g}."
+            f"écart maximal |{name} − {name}ᵀ| = {number_text(asym, '.3g')}."
         )
     return 0.5 * (M + M.T)
 
@@ -165,7 +182,7 @@ def check_psd(name: str, M: np.ndarray) -> np.ndarray:
     if lam_min < -1e-10 * max(1.0, float(np.max(np.abs(M)))):
         raise KalmanInputError(
             f"« {name} » doit être semi-définie positive (covariance) ; "
-            f"plus petite valeur propre = {lam_min:.3g} < 0."
+            f"plus petite valeur propre = {number_text(lam_min, '.3g')} < 0."
         )
     return M
 
@@ -179,7 +196,7 @@ def check_pd(name: str, M: np.ndarray) -> np.ndarray:
         lam_min = float(scipy.linalg.eigvalsh(M)[0])
         raise KalmanInputError(
             f"« {name} » doit être définie positive (covariance inversible) ; "
-            f"plus petite valeur propre = {lam_min:.3g}."
+            f"plus petite valeur propre = {number_text(lam_min, '.3g')}."
         ) from None
     return M
 

@@ -37,7 +37,7 @@ from ..core.linalg import centred_rows, covariance_factor, symmetrize, weighted_
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult
 from ..core.simulation import as_generator, check_positive_int
-from ..core.validation import KalmanInputError, as_float_array, as_gaussian, shape_text
+from ..core.validation import KalmanInputError, array_text, as_float_array, as_gaussian, shape_text
 from .engine import Correction, FilterFamily, run_filter
 from .extended import NONLINEAR_HINT
 
@@ -369,7 +369,7 @@ def particle_family(
         top = joint.max()
         if not np.isfinite(top):
             raise KalmanInputError(
-                f"Filtre particulaire, correction par y[{state.k}] = {np.array2string(y, precision=4)} : toutes "
+                f"Filtre particulaire, correction par y[{state.k}] = {array_text(y, significant=4)} : toutes "
                 "les particules ont un poids nul (la mesure est infiniment improbable pour chacune). Vérifiez la "
                 "mesure et R, augmentez Q, P0 ou le nombre de particules."
             )

@@ -46,7 +46,7 @@ import scipy.linalg
 from ..core.linalg import symmetrize
 from ..core.models import LinearGaussianModel, NonlinearModel
 from ..core.results import FilterResult, FilterRuns, freeze
-from ..core.validation import KalmanInputError, as_controls, as_gaussian, check_instance
+from ..core.validation import KalmanInputError, as_controls, as_gaussian, check_instance, number_text
 from .diffuse import DiffuseFilterResult, is_determined
 from .extended import NONLINEAR_HINT
 
@@ -228,7 +228,7 @@ def _close(a: np.ndarray, b: np.ndarray, scale: np.ndarray) -> np.ndarray:
 def _mismatch(where: str, what: str, k: int, err: float, filters: str) -> KalmanInputError:
     return KalmanInputError(
         f"« result » ne vient pas du {filters} de ce modèle : {what} au pas k = {k} ne correspond pas "
-        f"(écart relatif {err:.2g}). Lissez le résultat du filtre qui a utilisé ce même « model »{where}."
+        f"(écart relatif {number_text(err, '.2g')}). Lissez le résultat du filtre qui a utilisé ce même « model »{where}."
     )
 
 

@@ -31,6 +31,7 @@ import scipy.linalg
 from ..core.models import LinearGaussianModel, NonlinearModel
 from ..core.results import FilterResult
 from ..core.validation import (
+    number_text,
     KalmanInputError,
     as_square_matrix,
     as_vector,
@@ -106,7 +107,7 @@ def _check_information(R: Any, z: Any, n: int, R_name: str = "R_xx", z_name: str
         raise KalmanInputError(
             f"« {R_name} » doit être triangulaire supérieure (racine carrée de l'information, "
             f"{R_name}ᵀ{R_name} = P⁻¹) ; coefficient non nul sous la diagonale en ({i}, {j}) : "
-            f"{R_arr[i, j]:.3g}."
+            f"{number_text(R_arr[i, j], '.3g')}."
         )
     z_arr = as_vector(z_name, z, n)
     return R_arr, z_arr
@@ -187,7 +188,7 @@ def _lu_invertible(A: np.ndarray, name: str = "A"):
     notes utilise :math:`A^{-1}`). ``name="F"`` : jacobienne du SRIF étendu, évaluée à chaque pas."""
     sv = scipy.linalg.svdvals(A)
     if sv[-1] <= A.shape[0] * np.finfo(float).eps * sv[0]:
-        cond = f"conditionnement {sv[0] / max(sv[-1], 1e-300):.3g}"
+        cond = f"conditionnement {number_text(sv[0] / max(sv[-1], 1e-300), '.3g')}"
         if name == "A":
             raise KalmanInputError(
                 f"La matrice de transition « A » (F des notes) est singulière ({cond}) : la prédiction du "

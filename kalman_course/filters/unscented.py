@@ -51,6 +51,7 @@ from ..core.linalg import symmetrize
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, FilterRuns
 from ..core.validation import (
+    number_text,
     KalmanInputError,
     as_float_array,
     as_gaussian,
@@ -148,7 +149,7 @@ def _points(x: np.ndarray, P: np.ndarray, scale: float, where: str, what: str) -
         lam_min = float(scipy.linalg.eigvalsh(P)[0])
         raise KalmanInputError(
             f"UKF, {where} : la covariance {what} n'est plus définie positive (plus petite valeur propre "
-            f"{lam_min:.3g}) : la factorisation de Cholesky des points sigma échoue. Essayez un α plus grand "
+            f"{number_text(lam_min, '.3g')}) : la factorisation de Cholesky des points sigma échoue. Essayez un α plus grand "
             "(poids W₀ moins négatifs), κ ≥ 0, ou augmentez Q ou P0."
         ) from None
     return np.vstack([x, x + U, x - U])

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..core.jacobians import JacobianCheck, numerical_jacobian
 from .lie import _se3_exp, as_pose, hat3
-from ..core.validation import KalmanInputError, as_float_array, shape_text
+from ..core.validation import KalmanInputError, as_float_array, number_text, shape_text
 
 __all__ = [
     "PinholeCamera",
@@ -120,7 +120,7 @@ def _check_depth(P_cam: np.ndarray) -> None:
     if bad.size:
         i = int(bad[0])
         raise KalmanInputError(
-            f"Le point {i} est derrière la caméra ou dans son plan (Z' = {P_cam[i, 2]:.4g} m) : la projection "
+            f"Le point {i} est derrière la caméra ou dans son plan (Z' = {number_text(P_cam[i, 2], '.4g')} m) : la projection "
             f"à sténopé exige Z' > 0 pour tous les points ({bad.size} point(s) en défaut). Vérifiez la pose "
             "« T » (repère de la cible dans le repère de la caméra) et les points."
         )

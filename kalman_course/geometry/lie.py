@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.validation import KalmanInputError, as_float_array, as_vector, shape_text
+from ..core.validation import KalmanInputError, array_text, as_float_array, as_vector, number_text, shape_text
 
 __all__ = [
     "hat3",
@@ -79,7 +79,7 @@ def as_rotation(name: str, value: Any) -> np.ndarray:
     det = float(np.linalg.det(R))
     if err > ROTATION_TOL or abs(det - 1.0) > ROTATION_TOL:
         raise KalmanInputError(
-            f"« {name} » n'est pas une matrice de rotation : |RᵀR − I| max = {err:.2g}, det R = {det:.6g} "
+            f"« {name} » n'est pas une matrice de rotation : |RᵀR − I| max = {number_text(err, '.2g')}, det R = {number_text(det, '.6g')} "
             "(attendu RᵀR = I et det R = +1)."
         )
     return R
@@ -95,15 +95,15 @@ def as_pose(name: str, value: Any) -> np.ndarray:
     if np.max(np.abs(T[3] - [0.0, 0.0, 0.0, 1.0])) > ROTATION_TOL:
         raise KalmanInputError(
             f"« {name} » n'est pas une transformation rigide : sa dernière ligne doit être [0, 0, 0, 1] ; "
-            f"reçu {np.array2string(T[3], precision=4)}."
+            f"reçu {array_text(T[3], decimals=4)}."
         )
     try:
         as_rotation(name, T[:3, :3])
     except KalmanInputError:
         raise KalmanInputError(
             f"« {name} » n'est pas une transformation rigide : son bloc T[:3, :3] n'est pas une rotation "
-            f"(|RᵀR − I| max = {float(np.max(np.abs(T[:3, :3].T @ T[:3, :3] - np.eye(3)))):.2g}, "
-            f"det = {float(np.linalg.det(T[:3, :3])):.6g})."
+            f"(|RᵀR − I| max = {number_text(np.max(np.abs(T[:3, :3].T @ T[:3, :3] - np.eye(3))), '.2g')}, "
+            f"det = {number_text(np.linalg.det(T[:3, :3]), '.6g')})."
         ) from None
     return T
 

@@ -29,6 +29,7 @@ import scipy.linalg
 
 from ..core.models import LinearGaussianModel
 from ..core.validation import (
+    number_text,
     KalmanInputError,
     as_batch_measurements,
     as_controls,
@@ -291,7 +292,7 @@ def measurement_initialisation(model: LinearGaussianModel, y0: Any):
     cond = np.linalg.cond(model.C)
     if not np.isfinite(cond) or cond > 1e12:
         raise KalmanInputError(
-            f"« C » est (numériquement) singulière (conditionnement {cond:.3g}) : impossible d'initialiser "
+            f"« C » est (numériquement) singulière (conditionnement {number_text(cond, '.3g')}) : impossible d'initialiser "
             f"l'état par C⁻¹ y0."
         )
     C_inv = scipy.linalg.inv(model.C)
