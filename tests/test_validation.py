@@ -276,3 +276,33 @@ def test_numbers_in_error_messages_are_written_the_french_way(call, number):
     message = str(err.value)
     assert number in message, message
     assert not re.search(r"\d\.\d|e[+-]\d\d|(?<![\w−])-\d|\binf\b", message), message
+
+
+def test_error_message_numbers_match_the_babel_writing_without_importing_it():
+    """Les messages d'erreur écrivent leurs nombres sans Babel (le cœur n'en dépend pas) : même écriture
+    que kalman_course.numbers (Babel), référence indépendante, sur des valeurs de tous ordres de grandeur."""
+    from kalman_course import numbers
+    from kalman_course.core.validation import array_text, number_text
+
+    rng = np.random.default_rng(3)
+    values = [0.0, -0.0, 1.0, -1.5, 0.25, 1e-3, 9.995e-4, 0.00125, -0.00125, 999999.4, 1e6, 15099.0, -123456.789,
+              2.5e-15, 1.0e300, np.inf, -np.inf, np.nan, 0.5, 1.25, 0.125]
+    values += list(rng.standard_normal(40) * 10.0 ** rng.integers(-8, 9, 40))
+    for v in values:
+        for spec in (".2g", ".3g", ".4g", ".6g"):
+            assert number_text(v, spec) == numbers.format_spec(v, spec), (v, spec)
+    rows = rng.standard_normal((3, 4)) * 10.0 ** rng.integers(-5, 6, (3, 4))
+    for options in (dict(decimals=4), dict(significant=6, trim=True), dict(significant=4)):
+        for arr in (rows, rows[0], [0.125, 0.0, 0.0, 1.0]):
+            assert array_text(arr, **options) == numbers.format_array(arr, **options), (arr, options)
+
+
+def test_the_core_does_not_import_babel():
+    import subprocess
+    import sys
+
+    code = ("import sys, kalman_course as kc, numpy as np\n"
+            "try:\n    kc.kalman_filter(kc.LinearGaussianModel(1.0, 1.0, 1.0, 1.0), [0.0], 0.0, -1.0)\n"
+            "except kc.KalmanInputError as e:\n    assert '−1' in str(e), str(e)\n"
+            "assert 'babel' not in sys.modules and 'kalman_course.numbers' not in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True)

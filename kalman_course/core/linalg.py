@@ -105,9 +105,8 @@ def correct_many(X_pred: np.ndarray, P_pred: np.ndarray, nu: np.ndarray, H: np.n
 
     .. math::
 
-        S_i = H_iP^-_iH_i^T + R_i,\quad K_i = P^-_iH_i^TS_i^{-1},\quad x_i = x^-_i + K_i
-u_i,\quad
-        P_i = (I - K_iH_i)P^-_i\ \ 	ext{ou (Joseph)}\ \ (I-K_iH_i)P^-_i(I-K_iH_i)^T + K_iR_iK_i^T.
+        S_i = H_iP^-_iH_i^T + R_i,\quad K_i = P^-_iH_i^TS_i^{-1},\quad x_i = x^-_i + K_i\nu_i,\quad
+        P_i = (I - K_iH_i)P^-_i\ \ \text{ou (Joseph)}\ \ (I-K_iH_i)P^-_i(I-K_iH_i)^T + K_iR_iK_i^T.
 
     ``X_pred`` (N, n), ``P_pred`` (N, n, n), ``nu`` (N, m) ; ``H`` (m, n) commune ou (N, m, n) ;
     ``R`` (m, m) commune ou (N, m, m). :math:`K_i` vient de la résolution de :math:`S_iK_i^T = H_iP^-_i`

@@ -7,6 +7,8 @@ incorrecte est une erreur.
 
 from __future__ import annotations
 
+import math
+import re
 from typing import Any
 
 import numpy as np
@@ -142,21 +144,66 @@ def as_square_matrix(name: str, value: Any, n: int | None) -> np.ndarray:
     return arr
 
 
+#: Signe moins typographique, espace fine insécable (milliers, « × ») et exposants des messages.
+_MINUS, _NNBSP = "\u2212", "\u202f"
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+_SPEC_DIGITS = re.compile(r"^\.(\d+)g$")
+
+
+def _fixed_text(x: float, decimals: int, trim: bool = False) -> str:
+    """``x`` à ``decimals`` décimales, milliers séparés par une espace fine, virgule décimale."""
+    text = f"{round(x, decimals) + 0.0:,.{decimals}f}"
+    if trim and "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return text.replace(",", _NNBSP).replace(".", ",").replace("-", _MINUS)
+
+
+def _french_number(x: float, *, decimals: int | None = None, significant: int = 3, trim: bool = False) -> str:
+    r"""Le nombre d'un message d'erreur écrit à la française, avec les règles de
+    :func:`kalman_course.numbers.format_number` (``decimals`` fixes, ou ``significant`` chiffres et
+    écriture :math:`m \times 10^n` si :math:`|x| < 10^{-3}` ou :math:`|x| \ge 10^6`), sans Babel : le cœur
+    du paquet n'en dépend pas (les tests comparent les deux écritures)."""
+    if math.isnan(x):
+        return "NaN"
+    if math.isinf(x):
+        return ("" if x > 0 else _MINUS) + "∞"
+    if decimals is not None:
+        return _fixed_text(x, decimals, trim)
+    exponent = 0 if x == 0 else math.floor(math.log10(abs(x)))
+    rounded = 0.0 if x == 0 else round(x, significant - 1 - exponent)
+    if rounded != 0:
+        exponent = math.floor(math.log10(abs(rounded)))
+    if rounded != 0 and (exponent < -3 or exponent >= 6):
+        mantissa = _fixed_text(rounded / 10.0**exponent, significant - 1, trim).replace(_NNBSP, "")
+        return f"{mantissa}{_NNBSP}×{_NNBSP}10{str(exponent).translate(_SUPERSCRIPT)}"
+    return _fixed_text(rounded, max(significant - 1 - exponent, 0), trim)
+
+
 def number_text(value: Any, spec: str) -> str:
-    """Un nombre cité dans un message d'erreur, écrit à la française (« −1,23 × 10⁻³ ») par
-    :func:`kalman_course.numbers.format_spec` ; importé ici seulement : Babel ne se charge que si une
-    erreur est levée."""
-    from ..numbers import format_spec
+    """Un nombre cité dans un message d'erreur, écrit à la française (« −1,23 × 10⁻³ ») : ``spec`` est un
+    format ``.Ng`` (``N`` chiffres significatifs, zéros finals retirés), comme
+    ``kalman_course.numbers.format_spec(value, spec)``, qui donne la même écriture."""
+    match = _SPEC_DIGITS.match(spec)
+    if match is None:
+        raise ValueError(f"format de message non pris en charge : {spec!r} (attendu .Ng)")
+    return _french_number(float(value), significant=max(int(match[1]), 1), trim=True)
 
-    return format_spec(value, spec)
 
-
-def array_text(value: Any, **options: Any) -> str:
-    """Un vecteur cité dans un message d'erreur, écrit à la française par
-    :func:`kalman_course.numbers.format_array` (``options`` : ``decimals`` ou ``significant``…)."""
-    from ..numbers import format_array
-
-    return format_array(value, **options)
+def array_text(value: Any, *, decimals: int | None = None, significant: int = 3, trim: bool = False) -> str:
+    """Un vecteur cité dans un message d'erreur, écrit à la française comme
+    ``kalman_course.numbers.format_array(value, decimals=…)`` (ou ``significant=…``) : colonnes alignées à
+    droite, deux espaces entre elles."""
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        return _french_number(float(arr), decimals=decimals, significant=significant, trim=trim)
+    rows = np.atleast_2d(arr)
+    cells = [[_french_number(float(v), decimals=decimals, significant=significant, trim=trim) for v in row]
+             for row in rows]
+    width = max(len(c) for row in cells for c in row)
+    lines = ["  ".join(c.rjust(width) for c in row) for row in cells]
+    if arr.ndim == 1:
+        return f"[{lines[0]}]"
+    return "[" + "\n ".join(f"[{line}]" for line in lines) + "]"
 
 
 def symmetric_tolerance(M: np.ndarray) -> float:

@@ -13,7 +13,7 @@ sachant les mesures, d'où (Bar-Shalom, Li et Kirubarajan, 2001, § 5.4) :
   (mais les NEES successives d'un même tirage sont corrélées : on les moyenne sur des tirages de
   Monte-Carlo indépendants, pas dans le temps).
 
-Les fonctions de ce module sont pures (tableaux ou :class:`~kalman_course.results.FilterResult` en
+Les fonctions de ce module sont pures (tableaux ou :class:`~kalman_course.core.results.FilterResult` en
 entrée, petits objets figés en sortie) ; les lois et les tests viennent de ``scipy.stats``. Les
 covariances ne sont jamais inversées : on résout par Cholesky. Ce module n'importe pas matplotlib.
 """

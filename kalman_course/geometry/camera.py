@@ -226,10 +226,10 @@ def check_camera_jacobian(
 ):
     r"""Compare la jacobienne des pixels aux différences centrées **sur la rétraction** :
     :math:`\delta \mapsto h(T\,\mathrm{Exp}(\delta))` (droite) ou :math:`h(\mathrm{Exp}(\delta)\,T)` (gauche),
-    dérivée en :math:`\delta = 0` avec le pas ``step`` (:func:`kalman_course.jacobians.numerical_jacobian`).
+    dérivée en :math:`\delta = 0` avec le pas ``step`` (:func:`kalman_course.core.jacobians.numerical_jacobian`).
 
     ``jacobian`` (2n, 6) : la matrice à vérifier (par défaut :func:`camera_measurement_jacobian`).
-    Renvoie un :class:`~kalman_course.jacobians.JacobianCheck` (vrai si l'écart relatif au plus grand
+    Renvoie un :class:`~kalman_course.core.jacobians.JacobianCheck` (vrai si l'écart relatif au plus grand
     élément est sous ``rtol``)."""
     if perturbation not in ("right", "left"):
         raise KalmanInputError(

@@ -2,8 +2,9 @@ r"""Les formules **fausses** du support de cours (document 001), recopiées tell
 
 Ce module n'est là que pour montrer et tester les errata : aucun filtre du paquet ne l'utilise. Chaque
 fonction cite la ligne du support et l'identifiant d'erratum de ``ALGORITHMS.md`` §6.2 ; la forme
-correcte est ailleurs dans le paquet (:func:`kalman_course.kf.recipe_step`,
-:func:`kalman_course.estimator.error_transition`, :func:`kalman_course.estimator.measurement_initialisation`).
+correcte est ailleurs dans le paquet (:func:`kalman_course.filters.kalman.recipe_step`,
+:func:`kalman_course.lecture.estimator.error_transition`,
+:func:`kalman_course.lecture.estimator.measurement_initialisation`).
 """
 
 from __future__ import annotations
@@ -90,7 +91,7 @@ def printed_recipe_filter(model: LinearGaussianModel, y: Any, x0: Any, P0: Any) 
         \hat x_{n+1} = A\hat x_n + K_{n+1}[y_{n+1} - CA\hat x_n],\qquad
         P_{n+1} = (I - K_{n+1}C)(AP_nA^T + \Phi).
 
-    Sans commande. ``y`` (T, m) ; renvoie un :class:`~kalman_course.results.FilterResult` (``S`` y est le
+    Sans commande. ``y`` (T, m) ; renvoie un :class:`~kalman_course.core.results.FilterResult` (``S`` y est le
     dénominateur imprimé :math:`CAP_nA^TC^T + C\Psi C^T + \Psi`).
     """
     _check_square_observation(model, "de la recette")
@@ -119,7 +120,7 @@ def printed_recipe_filter(model: LinearGaussianModel, y: Any, x0: Any, P0: Any) 
 def printed_stability_radius(model: LinearGaussianModel, K: Any) -> float:
     r"""La condition de stabilité **telle qu'imprimée** (lignes 110 et 123, erratum 001-3) :
     rayon spectral de :math:`I - KC`, alors que l'erreur moyenne est propagée par :math:`(I - KC)A`
-    (voir :func:`kalman_course.estimator.error_transition`). ``K`` (n, m)."""
+    (voir :func:`kalman_course.lecture.estimator.error_transition`). ``K`` (n, m)."""
     check_instance("model", model, LinearGaussianModel)
     K_arr = as_matrix("K", K, model.n_state, model.n_obs)
     return spectral_radius(np.eye(model.n_state) - K_arr @ model.C)
@@ -128,7 +129,7 @@ def printed_stability_radius(model: LinearGaussianModel, K: Any) -> float:
 def printed_initialisation(model: LinearGaussianModel, y0: Any):
     r"""L'initialisation **telle qu'imprimée** (lignes 288–290, errata 001-5 et 001-6) :
     :math:`\hat x_0 = y_0` et :math:`P_0 = \Psi`. Juste seulement si :math:`C = I` ; la forme correcte
-    est :func:`kalman_course.estimator.measurement_initialisation`. Renvoie ``(x0_hat, P0)``."""
+    est :func:`kalman_course.lecture.estimator.measurement_initialisation`. Renvoie ``(x0_hat, P0)``."""
     _check_square_observation(model, "« x̂₀ = y₀, P₀ = Ψ »")
     y_arr = as_vector("y0", y0, model.n_obs)
     return y_arr.copy(), np.array(model.R)

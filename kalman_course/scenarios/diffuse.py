@@ -214,7 +214,7 @@ class DiffuseErrors:
         return float(np.nanmax(self.srif))
 
     def kf_max_at(self, exponent: int) -> float:
-        """Écart maximal du filtre de Kalman pour :math:`P_0 = 10^{\text{exponent}}I` (m)."""
+        """Écart maximal du filtre de Kalman pour :math:`P_0 = 10^{\\text{exponent}}I` (m)."""
         return float(self.kf_max[list(self.exponents).index(exponent)])
 
 
