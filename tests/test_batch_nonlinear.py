@@ -13,7 +13,7 @@ import kalman_course as kc
 from kalman_course.filters.engine import run_filter_runs
 from kalman_course.filters.extended import extended_kalman_filter_runs
 from kalman_course.filters.iterated import iterated_extended_kalman_filter_runs
-from kalman_course.filters.kalman import kalman_family
+from kalman_course.filters.diffuse import diffuse_family
 from kalman_course.filters.unscented import unscented_kalman_filter_runs
 from kalman_course.scenarios import radar
 from kalman_course.scenarios._motion import simulate_cv
@@ -170,7 +170,7 @@ def test_scalar_prior_accepted_like_the_single_run_filter(name, batch, single):
     """Un état scalaire (n = 1) : x0 et P0 scalaires, acceptés par le filtre seul, le sont aussi en lot."""
     linear = kc.LinearGaussianModel(A=0.9, C=1.0, Q=0.1, R=0.5)
     model = linear if name == "KF" else kc.NonlinearModel.from_linear(linear)
-    Y = np.random.default_rng(2).standard_normal((4, 15))
+    Y = np.random.default_rng(2).standard_normal((4, 15, 1))
     runs = batch(model, Y, 0.3, 2.0)
     for i in range(4):
         np.testing.assert_allclose(runs.run(i).x, single(model, Y[i], 0.3, 2.0).x, rtol=1e-12, atol=1e-14)
@@ -180,7 +180,7 @@ def test_common_control_is_used_by_every_run():
     lin = kc.LinearGaussianModel(np.eye(2), [[1.0, 0.0]], 0.1 * np.eye(2), [[0.5]], B=[[1.0], [0.5]])
     model = kc.NonlinearModel.from_linear(lin)
     rng = np.random.default_rng(3)
-    Y, U = rng.standard_normal((4, 12)), rng.standard_normal((12, 1))
+    Y, U = rng.standard_normal((4, 12, 1)), rng.standard_normal((12, 1))
     res = extended_kalman_filter_runs(model, Y, np.zeros(2), np.eye(2), U)
     ref = kc.kalman_filter_runs(lin, Y, np.zeros(2), np.eye(2), U)  # le KF en lot (covariances communes)
     np.testing.assert_allclose(res.x, ref.x, rtol=1e-12, atol=1e-12)
@@ -192,7 +192,7 @@ def test_common_control_is_used_by_every_run():
 
 @pytest.mark.parametrize("name, batch, single", FILTERS, ids=IDS)
 @pytest.mark.parametrize("change, message", [
-    (dict(Y=np.zeros((3, 5, 3))), r"« Y » doit être de forme \(N, T, 2\) : N ≥ 1 tirages de T ≥ 1 mesures ; reçu la forme \(3, 5, 3\)"),
+    (dict(Y=np.zeros((3, 5, 3))), r"« Y » doit être de forme \(N, T, 2\) : N ≥ 1 tirages de T ≥ 1 mesures de 2 composante\(s\) ; reçu la forme \(3, 5, 3\)"),
     (dict(Y=np.zeros((5, 2))), r"« Y » doit être de forme \(N, T, 2\).*reçu la forme \(5, 2\)"),
     (dict(Y=np.zeros((0, 5, 2))), r"« Y » doit être de forme \(N, T, 2\)"),
     (dict(Y=np.full((3, 5, 2), np.inf)), r"« Y » contient des valeurs infinies"),
@@ -211,17 +211,17 @@ def test_bad_batch_input_is_a_french_error(name, batch, single, change, message)
         batch(model, args["Y"], args["x0"], args["P0"], args["u"])
 
 
-def test_per_run_controls_and_linear_models_are_refused():
+def test_bad_controls_linear_models_and_families_without_batch_mode_are_refused():
     lin = kc.LinearGaussianModel(np.eye(2), [[1.0, 0.0]], 0.1 * np.eye(2), [[0.5]], B=[[1.0], [0.5]])
     model = kc.NonlinearModel.from_linear(lin)
-    with pytest.raises(kc.KalmanInputError, match=r"« u » doit être commune à tous les tirages en lot, de forme \(T, 1\)"):
-        extended_kalman_filter_runs(model, np.zeros((3, 4)), np.zeros(2), np.eye(2), np.zeros((3, 4, 1)))
+    with pytest.raises(kc.KalmanInputError, match=r"« u » doit être de forme \(4, 1\) \(commune\) ou \(3, 4, 1\) \(une suite"):
+        extended_kalman_filter_runs(model, np.zeros((3, 4, 1)), np.zeros(2), np.eye(2), np.zeros((2, 4, 1)))
     with pytest.raises(kc.KalmanInputError, match=r"« u » doit avoir une commande par pas de temps : 4 ligne"):
-        iterated_extended_kalman_filter_runs(model, np.zeros((3, 4)), np.zeros(2), np.eye(2), np.zeros((3, 1)))
+        iterated_extended_kalman_filter_runs(model, np.zeros((3, 4, 1)), np.zeros(2), np.eye(2), np.zeros((3, 1)))
     with pytest.raises(kc.KalmanInputError, match=r"« model » doit être un NonlinearModel ; reçu LinearGaussianModel"):
-        unscented_kalman_filter_runs(lin, np.zeros((3, 4)), np.zeros(2), np.eye(2), **UKF)
-    with pytest.raises(kc.KalmanInputError, match="Le filtre de Kalman n'a pas de mode en lot"):
-        run_filter_runs(kalman_family(), lin, np.zeros((3, 4)), np.zeros(2), np.eye(2))
+        unscented_kalman_filter_runs(lin, np.zeros((3, 4, 1)), np.zeros(2), np.eye(2), **UKF)
+    with pytest.raises(kc.KalmanInputError, match="Le filtre de Kalman à départ diffus n'a pas de mode en lot"):
+        run_filter_runs(diffuse_family(), lin, np.zeros((3, 4, 1)), None, None)
 
 
 def test_ukf_batch_errors_name_the_run_and_the_step():
@@ -249,6 +249,6 @@ def test_ekf_batch_error_names_the_run_when_S_is_not_positive_definite():
                               f_jacobian=np.eye(2), h_jacobian=H, h_noise_jacobian=V, n_obs=1, vectorized=True)
     X0 = np.array([[0.0, 0.0], [100.0, 0.0]])
     with pytest.raises(kc.KalmanInputError, match=r"n'est pas définie positive.*\(S, tirage 1, correction par y\[0\]\)"):
-        extended_kalman_filter_runs(model, np.zeros((2, 3)), X0, np.eye(2))
-    ref = extended_kalman_filter_runs(model, np.zeros((1, 3)), X0[:1], np.eye(2))  # le tirage 0 seul passe
+        extended_kalman_filter_runs(model, np.zeros((2, 3, 1)), X0, np.eye(2))
+    ref = extended_kalman_filter_runs(model, np.zeros((1, 3, 1)), X0[:1], np.eye(2))  # le tirage 0 seul passe
     assert ref.x.shape == (1, 3, 2)

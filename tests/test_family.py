@@ -33,6 +33,7 @@ class Member:
     run: Callable
     partial_rows: bool = True   # accepte une ligne partiellement manquante
     control: bool = True        # accepte une commande
+    vague: bool = False         # sûr pour un a priori vague (P0 = 10¹⁰ I à 10¹⁴ I)
 
 
 def _nonlinear(model):
@@ -44,18 +45,21 @@ def _ukf(model, y, x0, P0, u=None):
 
 
 FILTERS = [
-    Member("KF", lambda m, y, x0, P0, u=None: kc.kalman_filter(m, y, x0, P0, u)),
-    Member("KF (Joseph)", lambda m, y, x0, P0, u=None: kc.kalman_filter(m, y, x0, P0, u, joseph=True)),
-    Member("KF en lot", lambda m, y, x0, P0, u=None: kc.kalman_filter_runs(m, np.asarray(y)[None], x0, P0, u).run(0)),
+    Member("KF", lambda m, y, x0, P0, u=None: kc.kalman_filter(m, y, x0, P0, u), vague=True),
+    Member("KF (Joseph)", lambda m, y, x0, P0, u=None: kc.kalman_filter(m, y, x0, P0, u, form="joseph")),
+    Member("KF (cours)", lambda m, y, x0, P0, u=None: kc.kalman_filter(m, y, x0, P0, u, form="textbook")),
+    Member("KF en lot", lambda m, y, x0, P0, u=None: kc.kalman_filter_runs(m, np.asarray(y)[None], x0, P0, u).run(0),
+           vague=True),
     Member("EKF", lambda m, y, x0, P0, u=None: kc.extended_kalman_filter(_nonlinear(m), y, x0, P0, u)),
     Member("EKF itéré (1)", lambda m, y, x0, P0, u=None: kc.iterated_extended_kalman_filter(
         _nonlinear(m), y, x0, P0, u, max_iter=1)),
     Member("EKF itéré (20)", lambda m, y, x0, P0, u=None: kc.iterated_extended_kalman_filter(_nonlinear(m), y, x0, P0, u)),
-    Member("SRIF (inverse)", lambda m, y, x0, P0, u=None: kc.square_root_information_filter(m, y, x0, P0, u)),
+    Member("SRIF (inverse)", lambda m, y, x0, P0, u=None: kc.square_root_information_filter(m, y, x0, P0, u),
+           vague=True),
     Member("SRIF (joint)", lambda m, y, x0, P0, u=None: kc.square_root_information_filter(
         m, y, x0, P0, u, method="joint")),
     Member("SRIF étendu", lambda m, y, x0, P0, u=None: kc.extended_square_root_information_filter(
-        _nonlinear(m), y, x0, P0, u)),
+        _nonlinear(m), y, x0, P0, u), vague=True),
     Member("UKF (α=1, β=2, κ=0)", _ukf),
     # mode en lot du moteur (run_filter_runs), sur un lot d'un tirage
     Member("EKF en lot", lambda m, y, x0, P0, u=None: extended_kalman_filter_runs(
@@ -133,6 +137,55 @@ def test_nis_is_consistent_on_every_member():
     ref = kc.nis(kc.kalman_filter(model, y, x0, P0, u))
     for member in FILTERS:
         np.testing.assert_allclose(kc.nis(member.run(model, y, x0, P0, u)), ref, rtol=1e-8, err_msg=member.name)
+
+
+# --------------------------------------------------------------------------- a priori vague
+
+
+def _vague_case(name):
+    if name == "vitesse constante au mm":  # le scénario du chapitre SRIF : positions à 1 mm près, état à 100 m
+        return kc.scenarios.diffuse.diffuse_model(), kc.scenarios.diffuse.diffuse_data()[1]
+    rng = np.random.default_rng(5)  # 3 états, 2 mesures mélangées, dynamique stable
+    A = np.array([[0.9, 0.2, 0.0], [0.0, 0.8, 0.3], [0.1, 0.0, 0.7]])
+    model = kc.LinearGaussianModel(A, rng.standard_normal((2, 3)), 0.1 * np.eye(3), np.diag([0.5, 0.2]))
+    return model, kc.simulate(model, np.ones(3), 50, rng=4).y
+
+
+VAGUE = [f for f in FILTERS if f.vague]
+
+
+@pytest.mark.parametrize("member", VAGUE, ids=[f.name for f in VAGUE])
+@pytest.mark.parametrize("exponent", [10, 12, 14])
+@pytest.mark.parametrize("case", ["vitesse constante au mm", "3 états, 2 mesures"])
+def test_vague_prior_reaches_the_exact_diffuse_start(member, exponent, case):
+    """Un a priori vague x̂₀ = 0, P₀ = 10ᵏ I (ce qu'utilisent les étudiants et l'« approximate diffuse » de
+    statsmodels) : dès le 2ᵉ pas (le 1ᵉʳ ne détermine pas l'état), la moyenne est à moins de 10⁻⁸ du départ
+    diffus exact (filtre augmenté, vérifié contre statsmodels et l'arithmétique décimale à 120 chiffres),
+    et au moins aussi près que la forme de Joseph de filterpy. Mesuré : ≤ 1,1 × 10⁻⁹ pour le KF (racine
+    carrée), quand filterpy s'écarte de 10⁻⁷ à 0,5 et que la forme du cours échoue à 10¹² (S non définie
+    positive)."""
+    model, y = _vague_case(case)
+    n = model.n_state
+    exact = kc.diffuse_kalman_filter(model, y).x
+    assert np.isnan(exact[0]).all() and np.isfinite(exact[1:]).all()
+    P0 = 10.0**exponent * np.eye(n)
+    res = member.run(model, y, np.zeros(n), P0)
+    gap = np.max(np.abs(res.x[1:] - exact[1:]))
+    joseph = np.max(np.abs(filterpy_kf(model, y, np.zeros(n), P0)[0][1:] - exact[1:]))
+    assert gap < 1e-8, gap
+    assert gap <= joseph, (gap, joseph)
+    assert np.isfinite(res.P).all() and (np.linalg.eigvalsh(res.P[1:])[:, 0] > 0).all()
+
+
+def test_vague_prior_breaks_the_textbook_form_as_the_srif_chapter_shows():
+    """La forme du cours (P = P⁻ − KCP⁻), gardée pour le chapitre SRIF : avec P₀ = 10¹⁰ I elle s'écarte de plus
+    de 10⁻⁵ du départ diffus exact, et à 10¹² S n'est plus définie positive (erreur française)."""
+    model, y = _vague_case("vitesse constante au mm")
+    exact = kc.diffuse_kalman_filter(model, y).x
+    res = kc.kalman_filter(model, y, np.zeros(4), 1e10 * np.eye(4), form="textbook")
+    assert np.max(np.abs(res.x[1:] - exact[1:])) > 1e-5
+    with pytest.raises(kc.KalmanInputError, match=r"« S = C P⁻ Cᵀ \+ R » n'est pas définie positive"):
+        kc.kalman_filter(model, y, np.zeros(4), 1e12 * np.eye(4), form="textbook")
 
 
 # --------------------------------------------------------------------------- mêmes erreurs d'entrée
@@ -225,15 +278,46 @@ def test_runs_equal_kalman_filter_run_by_run(missing):
 def test_runs_bad_input():
     rng = np.random.default_rng(2)
     model = random_model(rng, 2, 1, 0)
-    with pytest.raises(kc.KalmanInputError, match=r"« Y » doit être de forme \(N, T, 1\) ou \(N, T\)"):
+    with pytest.raises(kc.KalmanInputError, match=r"« Y » doit être de forme \(N, T, 1\) : .* reçu la forme \(5,\)\.$"):
         kc.kalman_filter_runs(model, np.zeros(5), np.zeros(2), np.eye(2))
+    # 2-D : 30 tirages d'une mesure, ou un tirage de 30 mesures ? Refusé, avec les deux écritures possibles
+    with pytest.raises(kc.KalmanInputError, match=r"reçu la forme \(30, 1\) : pour un seul tirage, .* Y\[None\] ; "
+                                                  r"pour N tirages d'une mesure scalaire, donnez Y\[\.\.\., None\]"):
+        kc.kalman_filter_runs(model, np.zeros((30, 1)), np.zeros(2), np.eye(2))
+    Y = np.zeros((3, 5, 1))
     with pytest.raises(kc.KalmanInputError, match=r"« x0 » doit être de forme \(2,\) \(commun\) ou \(3, 2\)"):
-        kc.kalman_filter_runs(model, np.zeros((3, 5)), np.zeros((4, 2)), np.eye(2))
+        kc.kalman_filter_runs(model, Y, np.zeros((4, 2)), np.eye(2))
+    with pytest.raises(kc.KalmanInputError, match=r"« P0 » doit être de forme \(2, 2\) \(commune\) ou \(3, 2, 2\)"):
+        kc.kalman_filter_runs(model, Y, np.zeros(2), np.ones((4, 2, 2)))
+    with pytest.raises(kc.KalmanInputError, match=r"« P0\[1\] » doit être semi-définie positive"):
+        kc.kalman_filter_runs(model, Y, np.zeros(2), np.stack([np.eye(2), -np.eye(2), np.eye(2)]))
     with pytest.raises(kc.KalmanInputError, match=r"« u » est fourni mais le modèle n'a pas de matrice de commande B"):
-        kc.kalman_filter_runs(model, np.zeros((3, 5)), np.zeros(2), np.eye(2), u=np.zeros(5))
-    runs = kc.kalman_filter_runs(model, np.zeros((3, 5)), np.zeros(2), np.eye(2))
+        kc.kalman_filter_runs(model, Y, np.zeros(2), np.eye(2), u=np.zeros(5))
+    with pytest.raises(kc.KalmanInputError, match=r"« u » doit être de forme \(5, 1\) \(commune\) ou \(3, 5, 1\)"):
+        kc.kalman_filter_runs(kc.LinearGaussianModel(model.A, model.C, model.Q, model.R, B=np.ones((2, 1))), Y,
+                              np.zeros(2), np.eye(2), u=np.zeros((2, 5, 1)))
+    runs = kc.kalman_filter_runs(model, Y, np.zeros(2), np.eye(2))
     with pytest.raises(kc.KalmanInputError, match="« i » doit être un indice de tirage"):
         runs.run(3)
+
+
+def test_runs_with_a_prior_and_controls_per_run_equal_the_filter_run_by_run():
+    """P0 (N, n, n) et u (N, T, p) propres à chaque tirage : le KF en lot (et l'EKF en lot, qui prédit alors
+    tirage par tirage) redonne le filtre de chaque tirage."""
+    rng = np.random.default_rng(21)
+    model = _case(21, 3, 2, 1)[0]
+    N, T = 5, 25
+    U = rng.standard_normal((N, T, 1))
+    Y = np.stack([kc.simulate(model, rng.standard_normal(3), T, U[i], rng=rng).y for i in range(N)])
+    X0 = rng.standard_normal((N, 3))
+    P0 = np.stack([(1.0 + i) * np.eye(3) for i in range(N)])
+    for runs in (kc.kalman_filter_runs(model, Y, X0, P0, U),
+                 extended_kalman_filter_runs(_nonlinear(model), Y, X0, P0, U)):
+        assert not runs.shared_covariance and runs.P.shape == (N, T, 3, 3)
+        for i in range(N):
+            x, P, _, _ = filterpy_kf(model, Y[i], X0[i], P0[i], u=U[i])
+            np.testing.assert_allclose(runs.x[i], x, **TOL)
+            np.testing.assert_allclose(runs.P[i], P, **TOL)
 
 
 # --------------------------------------------------------------------------- filtres de Monte-Carlo

@@ -19,11 +19,11 @@ TOL = dict(atol=1e-10, rtol=1e-10)
 # --------------------------------------------------------------------------- filterpy
 
 
-@pytest.mark.parametrize("joseph", [False, True])
-def test_constant_voltage_equals_filterpy(joseph):
+@pytest.mark.parametrize("form", kc.filters.kalman.FORMS)
+def test_constant_voltage_equals_filterpy(form):
     model = kc.scenarios.constant_voltage_model()
     z = kc.scenarios.constant_voltage_measurements(500, rng=3)
-    ours = kc.kalman_filter(model, z, x0=0.0, P0=1.0, joseph=joseph)
+    ours = kc.kalman_filter(model, z, x0=0.0, P0=1.0, form=form)
     x, P, xp, Pp = filterpy_kf(model, z, [0.0], [[1.0]])
     np.testing.assert_allclose(ours.x, x, **TOL)
     np.testing.assert_allclose(ours.P, P, **TOL)
@@ -32,8 +32,8 @@ def test_constant_voltage_equals_filterpy(joseph):
 
 
 @pytest.mark.parametrize("n,m,p", [(1, 1, 1), (2, 1, 1), (3, 2, 1), (4, 2, 2), (6, 3, 2), (5, 5, 0)])
-@pytest.mark.parametrize("joseph", [False, True])
-def test_random_systems_equal_filterpy(n, m, p, joseph):
+@pytest.mark.parametrize("form", kc.filters.kalman.FORMS)
+def test_random_systems_equal_filterpy(n, m, p, form):
     rng = np.random.default_rng(100 * n + 10 * m + p)
     model = random_model(rng, n, m, p)
     T = 300
@@ -41,7 +41,7 @@ def test_random_systems_equal_filterpy(n, m, p, joseph):
     x0 = rng.standard_normal(n)
     sim = kc.simulate(model, x0, T, u=u, rng=rng)
     P0 = 2.0 * np.eye(n)
-    ours = kc.kalman_filter(model, sim.y, np.zeros(n), P0, u=u, joseph=joseph)
+    ours = kc.kalman_filter(model, sim.y, np.zeros(n), P0, u=u, form=form)
     x, P, xp, Pp = filterpy_kf(model, sim.y, np.zeros(n), P0, u=u)
     np.testing.assert_allclose(ours.x, x, **TOL)
     np.testing.assert_allclose(ours.P, P, **TOL)
@@ -149,10 +149,12 @@ def test_recipe_one_line_form_equals_predict_update(seed):
 def test_equivalent_update_forms(seed):
     model, x, P, u, y = _one_step(seed)
     pred = kc.predict(model, x, P, u)
-    short = kc.update(model, pred.x, pred.P, y, joseph=False)
-    joseph = kc.update(model, pred.x, pred.P, y, joseph=True)
-    np.testing.assert_allclose(short.P, joseph.P, atol=1e-12, rtol=1e-10)
-    np.testing.assert_allclose(short.x, joseph.x, atol=1e-12, rtol=1e-12)
+    short = kc.update(model, pred.x, pred.P, y, form="textbook")
+    for form in ("joseph", "square_root"):
+        other = kc.update(model, pred.x, pred.P, y, form=form)
+        for field in ("x", "P", "K", "S"):
+            np.testing.assert_allclose(getattr(other, field), getattr(short, field), atol=1e-12, rtol=1e-10,
+                                       err_msg=f"{form} : {field}")
     C, R = model.C, model.R
     # gain alternatif des tableaux (000) : K = P_{k|k} Cᵀ R⁻¹
     np.testing.assert_allclose(short.K, short.P @ C.T @ np.linalg.inv(R), atol=1e-10, rtol=1e-9)
@@ -206,13 +208,13 @@ def test_step_functions_compose_to_runner():
     m=st.integers(1, 4),
     seed=st.integers(0, 2**32 - 1),
     scale=st.floats(1e-3, 1e3),
-    joseph=st.booleans(),
+    form=st.sampled_from(kc.filters.kalman.FORMS),
 )
-def test_covariances_stay_symmetric_psd_and_shrink(n, m, seed, scale, joseph):
+def test_covariances_stay_symmetric_psd_and_shrink(n, m, seed, scale, form):
     rng = np.random.default_rng(seed)
     model = random_model(rng, n, m, 0)
     y = scale * rng.standard_normal((40, m))
-    res = kc.kalman_filter(model, y, np.zeros(n), scale * np.eye(n), joseph=joseph)
+    res = kc.kalman_filter(model, y, np.zeros(n), scale * np.eye(n), form=form)
     for P, Pp in zip(res.P, res.P_pred):
         np.testing.assert_array_equal(P, P.T)
         np.testing.assert_array_equal(Pp, Pp.T)

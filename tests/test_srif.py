@@ -197,7 +197,7 @@ def test_diffuse_demo_srif_exact_kalman_filter_off():
     ref = diffuse.extended_precision_estimates(model, y)  # vérifiée contre les moindres carrés en bloc ci-dessous
     sr = kc.square_root_information_filter(model, y)
     srif_err = np.abs(sr.x[1:, :2] - ref[1:, :2]).max()
-    kf = kc.kalman_filter(model, y, np.zeros(4), 1e10 * np.eye(4))
+    kf = kc.kalman_filter(model, y, np.zeros(4), 1e10 * np.eye(4), form="textbook")
     kf_err = np.abs(kf.x[1:, :2] - ref[1:, :2]).max()
     assert srif_err < 1e-12
     assert kf_err > 1e-5

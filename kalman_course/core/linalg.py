@@ -1,12 +1,22 @@
-r"""Algèbre linéaire commune à tous les filtres : symétrisation, gain par Cholesky, facteurs nommés.
+r"""Algèbre linéaire commune à tous les filtres : symétrisation, résolution définie positive, gain,
+corrections (forme du cours, de Joseph, en racine carrée), facteurs nommés.
 
 :math:`S` n'est jamais inversée : le gain :math:`K = P^-H^TS^{-1}` vient de la résolution de
-:math:`S K^T = H P^-` par Cholesky (LAPACK ``?posv`` via ``scipy.linalg``). Une factorisation qui échoue
-devient une :class:`~kalman_course.core.validation.KalmanInputError` qui dit quelle matrice et quoi
-vérifier, jamais une ``LinAlgError`` nue.
+:math:`S K^T = H P^-` par Cholesky — une seule fonction pour tout le paquet, :func:`psd_solve` (LAPACK
+``?posv`` pour une matrice, Cholesky en pile pour ``N`` tirages). Une factorisation qui échoue devient une
+:class:`~kalman_course.core.validation.KalmanInputError` qui dit quelle matrice et quoi vérifier, jamais
+une ``LinAlgError`` nue.
+
+**Racines carrées.** Une covariance :math:`P` peut être portée par une racine triangulaire supérieure
+:math:`U` (:math:`U^TU = P`, :func:`covariance_root`). Une somme de covariances
+:math:`M_1^TM_1 + M_2^TM_2` a pour racine le facteur :math:`R` de la QR de :math:`[M_1; M_2]`
+(:func:`triangular_root`) : aucune soustraction, donc aucun chiffre perdu (Morf & Kailath 1975 ;
+Bierman 1977). C'est la correction par défaut du filtre de Kalman (:func:`correct_square_root`).
 """
 
 from __future__ import annotations
+
+from functools import lru_cache
 
 import numpy as np
 import scipy.linalg
@@ -14,11 +24,11 @@ import scipy.linalg
 from .validation import KalmanInputError
 
 __all__ = [
-    "symmetrize", "kalman_gain", "correct", "solve_pd_many", "correct_many", "cholesky_factor", "covariance_factor",
-    "centred_rows", "weighted_rows",
+    "symmetrize", "psd_solve", "kalman_gain", "correct", "correct_many", "cholesky_factor", "covariance_factor",
+    "covariance_root", "triangular_root", "correct_square_root", "centred_rows", "weighted_rows",
 ]
 
-_posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
+_posv, _geqrf, _trtri = scipy.linalg.get_lapack_funcs(("posv", "geqrf", "trtri"), dtype=np.float64)
 
 #: Message par défaut quand :math:`S` n'est pas définie positive.
 S_NOT_PD = (
@@ -40,6 +50,39 @@ def symmetrize(P: np.ndarray) -> np.ndarray:
     return P
 
 
+def psd_solve(S: np.ndarray, B: np.ndarray, *, message: str = S_NOT_PD, where: str = "", name: str = "S") -> np.ndarray:
+    r"""Résout :math:`SX = B` pour :math:`S` symétrique définie positive, par Cholesky, sans jamais
+    former :math:`S^{-1}` : la résolution définie positive de tout le paquet (comme ``psd_solve`` de
+    dynamax).
+
+    ``S`` (m, m) et ``B`` (m,) ou (m, q) : LAPACK ``posv`` ; ``S`` (N, m, m) et ``B`` (N, m, q) : une pile,
+    matrice par matrice (``numpy.linalg.cholesky``). Renvoie ``X`` de la forme de ``B``.
+
+    Si :math:`S` (ou l'une des :math:`S_i`) n'est pas définie positive : :class:`KalmanInputError` avec
+    ``message``, précisé de ``where`` (« au pas 12 »…) et, pour une pile, de ``name`` et du premier
+    tirage fautif."""
+    if S.ndim == 2:
+        _, X, info = _posv(S, B)
+        if info != 0:
+            raise KalmanInputError(message if not where else f"{message[:-1]} ({where}).")
+        return X
+    try:
+        L = np.linalg.cholesky(S)
+    except np.linalg.LinAlgError:
+        bad = next(i for i in range(S.shape[0]) if not _is_pd(S[i]))
+        place = ", ".join([name, f"tirage {bad}"] + ([where] if where else []))
+        raise KalmanInputError(f"{message[:-1]} ({place}).") from None
+    return np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, B))
+
+
+def _is_pd(M: np.ndarray) -> bool:
+    try:
+        np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        return False
+    return True
+
+
 def kalman_gain(P_pred: np.ndarray, H: np.ndarray, R: np.ndarray, where: str = ""):
     r"""Gain :math:`K = P^-H^TS^{-1}` avec :math:`S = HP^-H^T + R`, par résolution de Cholesky.
 
@@ -48,9 +91,7 @@ def kalman_gain(P_pred: np.ndarray, H: np.ndarray, R: np.ndarray, where: str = "
     """
     PHt = P_pred.dot(H.T)
     S = H.dot(PHt) + R
-    _, Kt, info = _posv(S, PHt.T)
-    if info != 0:
-        raise KalmanInputError(S_NOT_PD if not where else f"{S_NOT_PD[:-1]} ({where}).")
+    Kt = psd_solve(S, PHt.T, where=where)  # S Kᵀ = H P⁻
     return Kt.T, S, PHt
 
 
@@ -76,28 +117,6 @@ def correct(x_pred: np.ndarray, P_pred: np.ndarray, nu: np.ndarray, H: np.ndarra
     return x, symmetrize(P), K, S
 
 
-def solve_pd_many(S: np.ndarray, B: np.ndarray, name: str, message: str, where: str = "") -> np.ndarray:
-    r"""Résout :math:`S_i X_i = B_i` pour une pile de matrices définies positives, par Cholesky.
-
-    ``S`` (N, m, m), ``B`` (N, m, q) ; renvoie ``X`` (N, m, q). Si une :math:`S_i` n'est pas définie
-    positive : :class:`KalmanInputError` avec ``message``, le premier tirage fautif et ``where``."""
-    try:
-        L = np.linalg.cholesky(S)
-    except np.linalg.LinAlgError:
-        bad = next(i for i in range(S.shape[0]) if not _is_pd(S[i]))
-        place = f"tirage {bad}" + (f", {where}" if where else "")
-        raise KalmanInputError(f"{message[:-1]} ({name}, {place}).") from None
-    return np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, B))
-
-
-def _is_pd(M: np.ndarray) -> bool:
-    try:
-        np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        return False
-    return True
-
-
 def correct_many(X_pred: np.ndarray, P_pred: np.ndarray, nu: np.ndarray, H: np.ndarray, R: np.ndarray,
                  joseph: bool = False, where: str = ""):
     r"""La correction linéaire de :func:`correct` sur ``N`` tirages à la fois (mêmes formules, tirage par
@@ -115,7 +134,7 @@ def correct_many(X_pred: np.ndarray, P_pred: np.ndarray, nu: np.ndarray, H: np.n
     Ht = np.swapaxes(H, -1, -2)
     PHt = P_pred @ Ht                                   # (N, n, m)
     S = H @ PHt + R                                     # (N, m, m)
-    K = np.swapaxes(solve_pd_many(S, np.swapaxes(PHt, -1, -2), "S", S_NOT_PD, where), -1, -2)
+    K = np.swapaxes(psd_solve(S, np.swapaxes(PHt, -1, -2), where=where), -1, -2)
     X = X_pred + (K @ nu[..., None])[..., 0]
     if joseph:
         IKH = np.eye(P_pred.shape[-1]) - K @ H
@@ -138,6 +157,115 @@ def covariance_factor(M: np.ndarray) -> np.ndarray:
     donc valable aussi pour une covariance singulière, par exemple :math:`Q = 0`)."""
     lam, V = scipy.linalg.eigh(M)
     return V * np.sqrt(np.clip(lam, 0.0, None))
+
+
+#: Seuil relatif sur la diagonale de la racine :math:`U_S` de :math:`S` : en deçà, :math:`S` est tenue pour
+#: singulière (conditionnement :math:`\gtrsim 10^{24}`, la QR en double précision n'en garde plus les petites
+#: valeurs propres).
+SINGULAR_ROOT_RTOL = 1e-12
+
+
+@lru_cache(maxsize=64)
+def _upper_mask(n: int) -> np.ndarray:
+    mask = np.triu(np.ones((n, n)))
+    mask.setflags(write=False)
+    return mask
+
+
+def triangular_root(M: np.ndarray) -> np.ndarray:
+    r"""Racine triangulaire supérieure :math:`U` (n, n) de :math:`M^TM` : le facteur :math:`R` de la QR
+    de Householder de ``M`` (r, n) (LAPACK ``geqrf``), :math:`U^TU = M^TM`.
+
+    Empiler des racines puis triangulariser, c'est additionner des covariances sans soustraction :
+    :math:`[U_1; U_2]` donne la racine de :math:`U_1^TU_1 + U_2^TU_2`. ``M`` (N, r, n) : une pile
+    (``numpy.linalg.qr``), renvoie (N, n, n). La diagonale de :math:`U` peut être négative (une racine
+    reste une racine)."""
+    r, n = M.shape[-2:]
+    if M.ndim > 2:
+        if r < n:
+            M = np.concatenate([M, np.zeros(M.shape[:-2] + (n - r, n))], axis=-2)
+        return np.linalg.qr(M, mode="r")
+    if r < n:
+        M = np.vstack([M, np.zeros((n - r, n))])
+    qr = _geqrf(M)[0]  # R au-dessus de la diagonale, réflecteurs de Householder au-dessous
+    return qr[:n] * _upper_mask(n)
+
+
+def covariance_root(P: np.ndarray) -> np.ndarray:
+    r"""Racine triangulaire supérieure :math:`U` (n, n) d'une covariance :math:`P` semi-définie positive,
+    :math:`U^TU = P` : Cholesky si :math:`P` est définie positive, sinon par ``eigh``
+    (:func:`covariance_factor`) puis :func:`triangular_root` (une covariance singulière, :math:`Q = 0`
+    par exemple, a aussi une racine). ``P`` (N, n, n) : une racine par matrice."""
+    try:
+        return np.swapaxes(np.linalg.cholesky(P), -1, -2)
+    except np.linalg.LinAlgError:
+        if P.ndim > 2:
+            return np.array([covariance_root(Pi) for Pi in P])
+        return triangular_root(covariance_factor(P).T)
+
+
+def correct_square_root(x_pred: np.ndarray, M_pred: np.ndarray, nu: np.ndarray, H: np.ndarray,
+                        U_R: np.ndarray, where: str = ""):
+    r"""Correction linéaire en racine carrée : la forme « tableau » de Morf et Kailath (1975).
+
+    Avec une racine :math:`M` de :math:`P^-` (:math:`M^TM = P^-`, ``r`` ≥ n lignes : triangulaire, ou
+    les racines empilées de la prédiction, :math:`[U A^T; U_Q]`) et :math:`U_R^TU_R = R`, une seule QR
+    (:func:`triangular_root`) du pré-tableau donne tout :
+
+    .. math::
+
+        \begin{bmatrix} U_R & 0 \\ MH^T & M \end{bmatrix}
+        \;\xrightarrow{\ \mathrm{QR}\ }\;
+        \begin{bmatrix} U_S & \bar K^T \\ 0 & U^+ \end{bmatrix},\qquad
+        U_S^TU_S = S = HP^-H^T + R,\quad (U^+)^TU^+ = P^- - P^-H^TS^{-1}HP^-,
+
+    et :math:`\bar K^T = U_S^{-T}HP^-`, d'où :math:`K^T = U_S^{-1}\bar K^T` (:math:`U_S` triangulaire,
+    :math:`m \times m`) et :math:`x = x^- + K\nu`. La covariance a posteriori n'est jamais calculée
+    par la soustraction :math:`P^- - KHP^-` : elle reste semi-définie positive et garde ses petites
+    valeurs propres même quand :math:`P^-` est énorme (a priori vague, :math:`P_0 = 10^{14}I`). Si un
+    élément diagonal de :math:`U_S` ne dépasse pas :data:`SINGULAR_ROOT_RTOL` fois le plus grand,
+    :math:`S` est singulière à la précision de la double (la QR n'en garde plus la petite racine) :
+    :class:`KalmanInputError`, comme la forme du cours.
+
+    ``x_pred`` (n,), ``M_pred`` (r, n), ``nu`` (m,), ``H`` (m, n), ``U_R`` (m, m) ; ou, pour ``N``
+    tirages, ``x_pred`` (N, n), ``nu`` (N, m) et ``M_pred`` (r, n) commune (covariances communes) ou
+    (N, r, n). Renvoie ``(x, U, K, U_S)`` : ``U`` (…, n, n) racine triangulaire de :math:`P`, ``K``
+    (…, n, m), ``U_S`` (…, m, m) racine de :math:`S`."""
+    m, n = H.shape
+    r = M_pred.shape[-2]
+    if M_pred.ndim > 2:  # une racine par tirage : QR en pile
+        pre = np.zeros(M_pred.shape[:-2] + (m + r, m + n))
+        pre[..., :m, :m] = U_R
+        pre[..., m:, :m] = M_pred @ H.T
+        pre[..., m:, m:] = M_pred
+        post = np.linalg.qr(pre, mode="r")
+        U_S = post[..., :m, :m]
+        _check_root(np.abs(np.diagonal(U_S, axis1=-2, axis2=-1)), where, stacked=True)
+        Kt = np.linalg.solve(U_S, post[..., :m, m:])
+        K = np.swapaxes(Kt, -1, -2)
+        return x_pred + (K @ nu[..., None])[..., 0], post[..., m:, m:], K, U_S
+    pre = np.zeros((m + r, m + n))
+    pre[:m, :m] = U_R
+    pre[m:, :m] = M_pred.dot(H.T)
+    pre[m:, m:] = M_pred
+    post = _geqrf(pre)[0][:m + n]
+    post *= _upper_mask(m + n)
+    U_S = post[:m, :m]
+    if m > 1:  # en flottants Python : une réduction numpy coûte plus cher que toute la correction
+        d = [abs(U_S.item(i, i)) for i in range(m)]
+        if min(d) <= SINGULAR_ROOT_RTOL * max(d):
+            _check_root(np.array([d]), where)
+    Kt = _trtri(U_S)[0].dot(post[:m, m:])  # U_S⁻¹ K̄ᵀ (U_S triangulaire, m × m)
+    return x_pred + nu.dot(Kt), post[m:, m:], Kt.T, U_S  # nu (N, m) : une ligne par tirage
+
+
+def _check_root(d: np.ndarray, where: str, stacked: bool = False) -> None:
+    """Diagonale(s) ``d`` (…, m) de la racine :math:`U_S` : :math:`S` numériquement singulière ?"""
+    singular = d.min(axis=-1) <= SINGULAR_ROOT_RTOL * d.max(axis=-1)
+    if np.any(singular):
+        place = [f"tirage {int(np.argmax(singular))}"] if stacked else []
+        place = ", ".join(place + ([where] if where else []))
+        raise KalmanInputError(f"{S_NOT_PD[:-1]} ({place})." if place else S_NOT_PD)
 
 
 #: Au plus autant de colonnes, les opérations « par ligne » d'un nuage (N, n) ∘ (n,) se font colonne par

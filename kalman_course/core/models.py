@@ -16,12 +16,14 @@ covariance bruit de mesure ``R``       :math:`\Psi` ``R``
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
 from .angles import wrap_angle
 from .jacobians import numerical_jacobian
+from .linalg import covariance_root
 from .validation import (
     KalmanInputError,
     as_float_array,
@@ -116,6 +118,13 @@ class LinearGaussianModel:
     def n_control(self) -> int:
         """Dimension ``p`` de la commande (0 sans matrice ``B``)."""
         return 0 if self.B is None else self.B.shape[1]
+
+    @cached_property
+    def noise_roots(self) -> tuple[np.ndarray, np.ndarray]:
+        r"""Racines triangulaires supérieures :math:`(U_Q, U_R)` des bruits, :math:`U_Q^TU_Q = Q` (n, n) et
+        :math:`U_R^TU_R = R` (m, m) (:func:`~kalman_course.core.linalg.covariance_root`), calculées une fois
+        pour le filtre de Kalman en racine carrée."""
+        return _readonly(covariance_root(self.Q)), _readonly(covariance_root(self.R))
 
     def __repr__(self) -> str:
         return f"LinearGaussianModel(n={self.n_state}, m={self.n_obs}, p={self.n_control})"

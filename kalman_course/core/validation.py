@@ -27,7 +27,9 @@ __all__ = [
     "as_gaussian",
     "symmetric_tolerance",
     "as_measurements",
+    "as_batch_measurements",
     "as_controls",
+    "as_batch_controls",
     "check_control_allowed",
     "check_instance",
     "call_user_function",
@@ -277,17 +279,37 @@ def as_measurements(name: str, y: Any, m: int) -> np.ndarray:
 
 
 def as_batch_measurements(name: str, Y: Any, m: int) -> np.ndarray:
-    """Mesures de ``N`` tirages ``(N, T, m)`` ; ``(N, T)`` accepté si ``m = 1`` ; ``NaN`` : manquante."""
+    """Mesures de ``N`` tirages, forme ``(N, T, m)`` exigée (``NaN`` : manquante). Un tableau 2-D est
+    refusé, même si ``m = 1`` : ``(30, 1)`` serait-il 30 tirages d'une mesure ou un tirage de 30 mesures ?"""
     arr = as_float_array(name, Y, allow_nan=True)
-    if arr.ndim == 2 and m == 1:
-        arr = arr[:, :, None]
-    if arr.ndim != 3 or arr.shape[2] != m or arr.shape[0] == 0 or arr.shape[1] == 0:
-        extra = " ou (N, T)" if m == 1 else ""
-        raise KalmanInputError(
-            f"« {name} » doit être de forme (N, T, {m}){extra} : N ≥ 1 tirages de T ≥ 1 mesures ; "
-            f"reçu {shape_text(arr.shape)}."
-        )
-    return arr
+    if arr.ndim == 3 and arr.shape[2] == m and arr.shape[0] > 0 and arr.shape[1] > 0:
+        return arr
+    if arr.ndim == 2:
+        hint = (f" : pour un seul tirage, filtrez-le sans « _runs » ou donnez {name}[None] ; pour N tirages "
+                f"d'une mesure scalaire, donnez {name}[..., None]")
+    else:
+        hint = ""
+    raise KalmanInputError(
+        f"« {name} » doit être de forme (N, T, {m}) : N ≥ 1 tirages de T ≥ 1 mesures de {m} composante(s) ; "
+        f"reçu {shape_text(arr.shape)}{hint}."
+    )
+
+
+def as_batch_controls(name: str, u: Any, N: int, n_steps: int, p: int) -> np.ndarray | None:
+    """Commandes de ``N`` tirages : ``(T, p)`` communes (``(T,)`` accepté si ``p = 1``) ou ``(N, T, p)``, une
+    suite par tirage ; ``None`` sans commande. Renvoie ``(T, p)`` ou ``(N, T, p)``."""
+    if u is None:
+        return None
+    check_control_allowed(name, p)
+    arr = as_float_array(name, u)
+    if arr.ndim == 3:
+        if arr.shape != (N, n_steps, p):
+            raise KalmanInputError(
+                f"« {name} » doit être de forme ({n_steps}, {p}) (commune) ou ({N}, {n_steps}, {p}) (une suite "
+                f"par tirage) ; reçu {shape_text(arr.shape)}."
+            )
+        return arr
+    return as_controls(name, arr, n_steps, p)
 
 
 def as_controls(name: str, u: Any, n_steps: int, p: int) -> np.ndarray | None:

@@ -30,7 +30,10 @@ d'entrée sont donc les mêmes pour tous les filtres.
 modèle (``prior_many``, ``predict_many``, ``update_many``, axe des tirages en tête) ; :func:`run_filter_runs`
 les enchaîne dans le temps — la même boucle, les mêmes vérifications, les mêmes mesures manquantes — et
 rend un :class:`~kalman_course.core.results.FilterRuns` (``x`` (N, T, n), ``P`` (N, T, n, n)…). Chaque
-tirage y est égal, aux arrondis près, à :func:`run_filter` sur ses seules mesures.
+tirage y est égal, aux arrondis près, à :func:`run_filter` sur ses seules mesures. Quand la récurrence
+des covariances ne dépend pas des mesures (famille ``shared_covariance``, filtre de Kalman linéaire) et
+qu'aucune mesure ne manque, le même moteur la calcule **une fois** pour tous les tirages (« Riccati
+commune ») : seules les moyennes sont propagées en lot.
 """
 
 from __future__ import annotations
@@ -45,6 +48,7 @@ from ..core.results import FilterHistory, FilterResult, FilterRuns
 from ..core.simulation import as_generator
 from ..core.validation import (
     KalmanInputError,
+    as_batch_controls,
     as_batch_measurements,
     as_batch_vector,
     as_controls,
@@ -96,12 +100,20 @@ class FilterFamily:
     dans le temps et passées à ``result_type``.
 
     Mode en lot (facultatif, pour :func:`run_filter_runs`) : ``prior_many(model, x0, P0, N)`` → état
-    interne des ``N`` tirages, un **tuple de tableaux dont le premier axe est celui des tirages** et dont
-    les deux premiers sont :math:`\hat X` (N, n) et :math:`P` (N, n, n) ; ``predict_many(model, state, u_k, k)``
-    → état prédit (``k`` : indice de la mesure visée, pour nommer le pas dans un message) ;
+    interne des ``N`` tirages, un **tuple de tableaux dont le premier axe est celui des tirages** ;
+    ``moments(state)`` doit alors rendre :math:`(\hat X, P)` de formes (N, n) et (N, n, n) ;
+    ``predict_many(model, state, u_k, k)`` → état prédit (``k`` : indice de la mesure visée, pour nommer
+    le pas dans un message ; ``u_k`` : (p,) commune, ou (N, p) si ``batch_controls``) ;
     ``update_many(model, state, Y_k, idx, k)`` → ``(état corrigé, Correction)``, où ``state`` et ``Y_k``
     (g, m_k) ne contiennent que les ``g`` tirages qui observent les composantes ``idx`` (``None`` :
     toutes) et où les champs de la :class:`Correction` ont un axe des tirages en tête (``n_iter`` (g,)).
+
+    ``batch_controls`` : ``predict_many`` accepte des commandes propres à chaque tirage, ``u_k`` (N, p)
+    (sinon le moteur prédit ces tirages un par un). ``shared_covariance`` : la récurrence des
+    covariances ne dépend pas des mesures (filtre de Kalman linéaire) ; sans mesure manquante et avec un
+    ``P0`` commun, le moteur appelle ``prior_many(model, x0, P0, N, shared=True)``, qui rend un état dont
+    seule la moyenne a l'axe des tirages (covariance, ou sa racine, sans cet axe), et les étapes en lot
+    calculent alors la covariance une fois pour tous (``K``, ``S`` sans axe des tirages).
     """
 
     name: str
@@ -119,6 +131,8 @@ class FilterFamily:
     prior_many: Callable[[Any, Any, Any, int], Any] | None = None
     predict_many: Callable[[Any, Any, np.ndarray | None, int], Any] | None = None
     update_many: Callable[[Any, Any, np.ndarray, np.ndarray | None, int], tuple[Any, Correction]] | None = None
+    batch_controls: bool = False
+    shared_covariance: bool = False
 
 
 def gaussian_prior(model: Any, x0: Any, P0: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -126,10 +140,10 @@ def gaussian_prior(model: Any, x0: Any, P0: Any) -> tuple[np.ndarray, np.ndarray
     return as_gaussian(x0, P0, model.n_state, "x0", "P0")
 
 
-def gaussian_prior_many(model: Any, x0: Any, P0: Any, N: int, definite: bool = False):
+def gaussian_prior_many(model: Any, x0: Any, P0: Any, N: int, definite: bool = False, shared: bool = False):
     """A priori de ``N`` tirages : ``x0`` (n,) commun ou (N, n) un par tirage ; ``P0`` (n, n) commune ou
     (N, n, n) une par tirage, symétrique semi-définie positive (``definite=True`` : définie positive).
-    Renvoie ``(X0 (N, n), P0 (N, n, n))`` (copies)."""
+    Renvoie ``(X0 (N, n), P0 (N, n, n))`` (copies) ; ``shared=True`` : ``P0`` commune rendue (n, n)."""
     n = model.n_state
     X0 = as_batch_vector("x0", x0, n, N)
     check = check_pd if definite else check_psd
@@ -143,13 +157,16 @@ def gaussian_prior_many(model: Any, x0: Any, P0: Any, N: int, definite: bool = F
         for i in range(N):
             check(f"P0[{i}]", P[i])
     else:
-        P = np.broadcast_to(check("P0", as_square_matrix("P0", P, n)), (N, n, n))
+        P = check("P0", as_square_matrix("P0", P, n))
+        if not shared:
+            P = np.broadcast_to(P, (N, n, n))
     return X0, np.array(P, dtype=float)
 
 
-def gaussian_moments(state: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    r"""L'état interne d'un filtre gaussien est déjà :math:`(\hat x, P)`."""
-    return state
+def gaussian_moments(state: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
+    r"""L'état interne d'un filtre gaussien commence par :math:`(\hat x, P)` (il peut porter d'autres
+    tableaux ensuite, par exemple une racine de :math:`P`) : le moteur les lit sans appel de fonction."""
+    return state[0], state[1]
 
 
 def observed_rows(Y: np.ndarray) -> np.ndarray:
@@ -198,10 +215,10 @@ def run_filter(
     state = prior(model, x0, P0)
     observed = observed_rows(Y)
     out = FilterHistory(T, family.state_shape(model), family.tangent_dim(model), m, observed)
-    full = observed.all(axis=1)
-    some = observed.any(axis=1)
+    full = observed.all(axis=1).tolist()  # booléens Python : la boucle n'indexe pas de tableau numpy à chaque pas
+    some = observed.any(axis=1).tolist()
     extras: dict[str, list] = {}
-    # boucle chaude : références locales, pas d'appel superflu (moments identiques pour les filtres gaussiens)
+    # boucle chaude : références locales, pas d'appel superflu (moments lus sans appel pour les filtres gaussiens)
     moments = None if family.moments is gaussian_moments else family.moments
     step_outputs = family.step_outputs
     xs, Ps, xps, Pps = out.x, out.P, out.x_pred, out.P_pred
@@ -218,8 +235,8 @@ def run_filter(
         else:
             state = predicted
         if moments is None:
-            xps[k], Pps[k] = predicted
-            xs[k], Ps[k] = state
+            xps[k], Pps[k] = predicted[0], predicted[1]
+            xs[k], Ps[k] = state[0], state[1]
         else:
             xps[k], Pps[k] = moments(predicted)
             xs[k], Ps[k] = moments(state)
@@ -242,16 +259,21 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
     composantes observées, et les tirages sans aucune mesure au pas ``k`` ne font que la prédiction
     (gain nul, innovation et ``S`` NaN, ``n_iter`` = 0).
 
+    **Riccati commune.** Pour une famille ``shared_covariance`` (filtre de Kalman linéaire), sans mesure
+    manquante et avec un ``P0`` commun, les covariances, gains et :math:`S` ne dépendent pas des mesures :
+    ils sont calculés une fois, dans cette même boucle, et rangés sans axe des tirages (forme (T, …)).
+
     Paramètres
     ----------
     model : le modèle de la famille (vérifié).
-    Y : (N, T, m), ou (N, T) si m = 1 — mesures des ``N`` tirages ; ``NaN`` : composante manquante.
+    Y : (N, T, m) — mesures des ``N`` tirages (un tableau 2-D est refusé) ; ``NaN`` : composante manquante.
     x0 : (n,) commun ou (N, n) ; P0 : (n, n) commune ou (N, n, n) — vérifiés par ``family.prior_many``.
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes **communes** à tous les tirages.
+    u : (T, p) commune à tous les tirages, ou (N, T, p) une suite par tirage (``(T,)`` accepté si p = 1).
 
     Renvoie un :class:`~kalman_course.core.results.FilterRuns` : ``x``, ``x_pred`` (N, T, n), ``P``,
     ``P_pred`` (N, T, n, n), ``K`` (N, T, n, m), ``innovation`` (N, T, m), ``S`` (N, T, m, m),
-    ``observed`` (N, T, m), ``n_iter`` (N, T) ; ``result.run(i)`` est le :class:`FilterResult` du tirage ``i``.
+    ``observed`` (N, T, m), ``n_iter`` (N, T) — ``P``, ``P_pred``, ``K``, ``S`` de forme (T, …) avec la
+    Riccati commune ; ``result.run(i)`` est le :class:`FilterResult` du tirage ``i``.
     """
     check_instance("model", model, family.model_type, family.model_hint)
     if family.predict_many is None or family.update_many is None or family.prior_many is None:
@@ -261,27 +283,32 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
     m = model.n_obs
     Yarr = as_batch_measurements("Y", Y, m)
     N, T, _ = Yarr.shape
-    if u is not None and np.ndim(u) == 3:
-        raise KalmanInputError(
-            f"« u » doit être commune à tous les tirages en lot, de forme (T, {model.n_control}) ; reçu "
-            f"{shape_text(np.shape(u))} : pour des commandes propres à chaque tirage, filtrez-les un par un."
-        )
-    U = as_controls("u", u, T, model.n_control)
-    state = family.prior_many(model, x0, P0, N)
-    n = state[0].shape[-1]
+    U = as_batch_controls("u", u, N, T, model.n_control)
     observed = ~np.isnan(Yarr)
-    xs, xps = np.empty((N, T, n)), np.empty((N, T, n))
-    Ps, Pps = np.empty((N, T, n, n)), np.empty((N, T, n, n))
-    Ks = np.zeros((N, T, n, m))  # gain nul pour une composante manquante : aucune correction
-    nus = np.full((N, T, m), np.nan)
-    Ss = np.full((N, T, m, m), np.nan)
-    n_iter = np.zeros((N, T), dtype=int)
     full = observed.all(axis=2)  # (N, T)
+    shared = family.shared_covariance and bool(full.all()) and np.ndim(P0) < 3
+    state = family.prior_many(model, x0, P0, N, shared=True) if shared else family.prior_many(model, x0, P0, N)
+    moments = family.moments
+    n = moments(state)[0].shape[-1]
+    lead = () if shared else (N,)  # axe des tirages des covariances, gains et S
+    xs, xps = np.empty((N, T, n)), np.empty((N, T, n))
+    Ps, Pps = np.empty(lead + (T, n, n)), np.empty(lead + (T, n, n))
+    Ks = np.zeros(lead + (T, n, m))  # gain nul pour une composante manquante : aucune correction
+    nus = np.full((N, T, m), np.nan)
+    Ss = np.full(lead + (T, m, m), np.nan)
+    n_iter = np.zeros((N, T), dtype=int)
+    run_by_run = U is not None and U.ndim == 3 and not family.batch_controls
     for k in range(T):
-        predicted = family.predict_many(model, state, None if U is None else U[k], k)
+        if run_by_run:
+            predicted = _predict_run_by_run(family, model, state, U[:, k], k)
+        else:
+            predicted = family.predict_many(model, state, None if U is None else U[..., k, :], k)
         if full[:, k].all():
             state, corr = family.update_many(model, predicted, Yarr[:, k], None, k)
-            Ks[:, k], nus[:, k], Ss[:, k], n_iter[:, k] = corr
+            if shared:
+                Ks[k], nus[:, k], Ss[k], n_iter[:, k] = corr
+            else:
+                Ks[:, k], nus[:, k], Ss[:, k], n_iter[:, k] = corr
         else:
             state = tuple(np.array(a) for a in predicted)
             patterns, group = np.unique(observed[:, k], axis=0, return_inverse=True)
@@ -295,10 +322,20 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
                 for a, b in zip(state, new):
                     a[runs] = b
                 _store_correction(Ks, nus, Ss, n_iter, runs, k, idx, corr)
-        xps[:, k], Pps[:, k] = predicted[0], predicted[1]
-        xs[:, k], Ps[:, k] = state[0], state[1]
+        xps[:, k], P_pred = moments(predicted)
+        xs[:, k], P = moments(state)
+        if shared:
+            Pps[k], Ps[k] = P_pred, P
+        else:
+            Pps[:, k], Ps[:, k] = P_pred, P
     return FilterRuns(x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss,
                       observed=observed, n_iter=n_iter)
+
+
+def _predict_run_by_run(family: FilterFamily, model: Any, state: tuple, U_k: np.ndarray, k: int) -> tuple:
+    """Prédiction de chaque tirage avec sa propre commande ``U_k[i]`` (famille sans ``batch_controls``)."""
+    parts = [family.predict_many(model, tuple(a[i:i + 1] for a in state), U_k[i], k) for i in range(U_k.shape[0])]
+    return tuple(np.concatenate(arrays) for arrays in zip(*parts))
 
 
 def _store_correction(Ks, nus, Ss, n_iter, runs, k, idx, corr) -> None:

@@ -1,10 +1,29 @@
-r"""Filtre de Kalman linéaire : étapes pures ``predict`` / ``update`` et une boucle ``kalman_filter``.
+r"""Filtre de Kalman linéaire : étapes pures ``predict`` / ``update``, leur famille pour le moteur, les
+boucles ``kalman_filter`` et ``kalman_filter_runs``.
 
 Notations (cours → paquet) : :math:`A, B, C` identiques, :math:`\Phi \to Q`, :math:`\Psi \to R`,
 :math:`\hat x^-_{n+1} \to` ``x_pred``, :math:`\hat x_{n+1} \to` ``x``.
 
-Les étapes publiques vérifient leurs entrées ; la boucle les vérifie une fois puis appelle les noyaux
-internes (mêmes formules, sans vérification répétée).
+**Trois formes de la covariance a posteriori** (option ``form``, mêmes valeurs en arithmétique exacte) :
+
+* ``"square_root"`` (par défaut) : le filtre propage une racine triangulaire :math:`U` de :math:`P`
+  (:math:`U^TU = P`) ; prédiction et correction sont chacune une QR d'un pré-tableau
+  (:func:`~kalman_course.core.linalg.triangular_root`,
+  :func:`~kalman_course.core.linalg.correct_square_root`). Aucune soustraction de covariances : :math:`P`
+  reste semi-définie positive et garde ses petites valeurs propres quand :math:`P_0` est vague. Mesuré
+  (``tests/test_family.py``) : avec :math:`P_0 = 10^{10}I` puis :math:`10^{14}I`, l'écart au départ
+  diffus exact reste de l'ordre de :math:`10^{-11}` à :math:`10^{-8}`, quand la forme de Joseph (celle
+  de filterpy) s'écarte de :math:`10^{-5}` à :math:`10^{-3}` et que la forme du cours échoue
+  (:math:`S` n'est plus définie positive). C'est pourquoi elle est la forme par défaut ; son coût reste
+  sous celui de filterpy (``benchmarks/kf_vs_filterpy.py``).
+* ``"textbook"`` : la formule du cours :math:`P = (I - KC)P^-`, calculée :math:`P^- - K(P^-C^T)^T` ; la
+  moins coûteuse, exacte pour le gain optimal, mais elle soustrait deux nombres de l'ordre de :math:`P^-`
+  et perd tous ses chiffres quand :math:`P^-` est très grande devant :math:`R` (chapitre SRIF).
+* ``"joseph"`` : :math:`P = (I - KC)P^-(I - KC)^T + KRK^T`, valable pour un gain quelconque, somme de
+  termes semi-définis positifs.
+
+Les étapes publiques vérifient leurs entrées ; les boucles les vérifient une fois (le moteur) puis
+appellent les noyaux internes (mêmes formules, sans vérification répétée).
 """
 
 from __future__ import annotations
@@ -14,27 +33,23 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from ..core.linalg import S_NOT_PD, correct, kalman_gain, symmetrize
+from ..core.linalg import (
+    correct, correct_many, correct_square_root, covariance_root, kalman_gain, symmetrize, triangular_root,
+)
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult, FilterRuns
-from ..core.validation import (
-    as_batch_measurements,
-    as_batch_vector,
-    KalmanInputError,
-    as_float_array,
-    as_gaussian,
-    as_square_matrix,
-    as_vector,
-    check_control_allowed,
-    check_instance,
-    check_psd,
-    shape_text,
+from ..core.validation import KalmanInputError, as_gaussian, as_vector, check_control_allowed
+from .engine import (
+    Correction, FilterFamily, gaussian_moments, gaussian_prior, gaussian_prior_many, run_filter, run_filter_runs,
 )
-from .engine import Correction, FilterFamily, gaussian_moments, gaussian_prior, run_filter
 
 __all__ = [
-    "Prediction", "Update", "predict", "update", "kalman_filter", "kalman_family", "kalman_filter_runs", "recipe_step",
+    "FORMS", "Prediction", "Update", "predict", "update", "kalman_filter", "kalman_family", "kalman_filter_runs",
+    "recipe_step",
 ]
+
+#: Formes de la covariance a posteriori (voir l'en-tête du module) ; la première est celle par défaut.
+FORMS = ("square_root", "textbook", "joseph")
 
 
 class Prediction(NamedTuple):
@@ -56,6 +71,14 @@ class Update(NamedTuple):
     K: np.ndarray
     innovation: np.ndarray
     S: np.ndarray
+
+
+def _check_form(form: Any) -> str:
+    if form not in FORMS:
+        raise KalmanInputError(
+            f"« form » doit être l'une des formes {', '.join(repr(f) for f in FORMS)} ; reçu {form!r}."
+        )
+    return form
 
 
 # --------------------------------------------------------------------------- noyaux internes
@@ -99,7 +122,7 @@ def predict(model: LinearGaussianModel, x: Any, P: Any, u: Any = None) -> Predic
     return Prediction(x_pred, P_pred)
 
 
-def update(model: LinearGaussianModel, x_pred: Any, P_pred: Any, y: Any, joseph: bool = False) -> Update:
+def update(model: LinearGaussianModel, x_pred: Any, P_pred: Any, y: Any, *, form: str = FORMS[0]) -> Update:
     r"""Étape de correction (*measurement update*).
 
     .. math::
@@ -110,24 +133,22 @@ def update(model: LinearGaussianModel, x_pred: Any, P_pred: Any, y: Any, joseph:
         \hat x_{k\mid k} = \hat x_{k\mid k-1} + K_k\nu_k,\qquad
         P_{k\mid k} = (I - K_kC)\,P_{k\mid k-1}
 
-    ``S`` n'est jamais inversée : :math:`K` est obtenu en résolvant :math:`S K^T = C P^-` par Cholesky
-    (LAPACK ``posv``) ; une ``S`` non définie positive lève une :class:`KalmanInputError`.
-
-    Par défaut (``joseph=False``), la covariance a posteriori suit la forme du cours
-    :math:`P = (I - KC)P^-`, calculée comme :math:`P^- - K(P^-C^T)^T` puis symétrisée : c'est la formule
-    enseignée et la moins coûteuse, exacte pour le gain optimal. ``joseph=True`` utilise la forme de Joseph
-
-    .. math:: P_{k\mid k} = (I - K_kC)P_{k\mid k-1}(I-K_kC)^T + K_kRK_k^T,
-
-    somme de termes semi-définis positifs, valable pour n'importe quel gain et plus robuste aux arrondis
-    quand :math:`P` est mal conditionnée (c'est la forme de filterpy) ; elle coûte environ 30 % de plus.
+    ``S`` n'est jamais inversée. ``form`` choisit le calcul de :math:`P_{k\mid k}` (voir l'en-tête du
+    module) : ``"square_root"`` (par défaut) part d'une racine de :math:`P_{k\mid k-1}` et fait une QR ;
+    ``"textbook"`` calcule :math:`P^- - K(P^-C^T)^T`, :math:`K` résolvant :math:`SK^T = CP^-` par
+    Cholesky (LAPACK ``posv``) ; ``"joseph"`` calcule
+    :math:`(I - K_kC)P_{k\mid k-1}(I-K_kC)^T + K_kRK_k^T`.
 
     Paramètres : ``x_pred`` (n,), ``P_pred`` (n, n), ``y`` (m,) (scalaire accepté si m = 1).
     """
+    form = _check_form(form)
     x_arr, P_arr = _check_state(x_pred, P_pred, model.n_state, "x_pred", "P_pred")
     y_arr = as_vector("y", y, model.n_obs)
     nu = y_arr - model.C @ x_arr
-    x, P, K, S = correct(x_arr, P_arr, nu, model.C, model.R, joseph)
+    if form == "square_root":
+        x, U, K, U_S = correct_square_root(x_arr, covariance_root(P_arr), nu, model.C, model.noise_roots[1])
+        return Update(x, U.T.dot(U), K, nu, U_S.T.dot(U_S))
+    x, P, K, S = correct(x_arr, P_arr, nu, model.C, model.R, form == "joseph")
     return Update(x, P, K, nu, S)
 
 
@@ -157,7 +178,7 @@ def recipe_step(model: LinearGaussianModel, x: Any, P: Any, y: Any, u: Any = Non
     return x_new, P_new, K
 
 
-# --------------------------------------------------------------------------- boucle
+# --------------------------------------------------------------------------- boucles
 
 
 def kalman_filter(
@@ -166,7 +187,8 @@ def kalman_filter(
     x0: Any,
     P0: Any,
     u: Any = None,
-    joseph: bool = False,
+    *,
+    form: str = FORMS[0],
 ) -> FilterResult:
     r"""Filtre de Kalman sur toutes les mesures : pour chaque ``y[k]``, prédiction puis correction.
 
@@ -183,8 +205,9 @@ def kalman_filter(
     x0 : (n,) — :math:`\hat x_0` (scalaire accepté si n = 1).
     P0 : (n, n) — :math:`P_0`, symétrique semi-définie positive (scalaire accepté si n = 1).
     u : (T, p), ou (T,) si p = 1, optionnel — commandes (exige un modèle avec ``B``).
-    joseph : bool — forme de Joseph pour la covariance a posteriori (``False`` par défaut : forme du
-        cours ; voir :func:`update`).
+    form : ``"square_root"`` (par défaut : racine carrée de :math:`P`, sûre pour un :math:`P_0` vague),
+        ``"textbook"`` (:math:`P = (I - KC)P^-`, la formule du cours) ou ``"joseph"`` — voir l'en-tête
+        du module.
 
     Renvoie
     -------
@@ -192,39 +215,7 @@ def kalman_filter(
         ``x`` (T, n), ``P`` (T, n, n), ``x_pred``, ``P_pred``, ``K`` (T, n, m), ``innovation`` (T, m),
         ``S`` (T, m, m), ``observed`` (T, m).
     """
-    return run_filter(kalman_family(joseph), model, y, x0, P0, u)
-
-
-def kalman_family(joseph: bool = False) -> FilterFamily:
-    r"""Les étapes du filtre de Kalman linéaire pour le moteur :func:`~kalman_course.filters.engine.run_filter`
-    (état interne :math:`(\hat x, P)`)."""
-
-    def predict_step(model: LinearGaussianModel, state, u):
-        x, P = state
-        return _predict(x, P, model.A, model.Q, None if u is None else model.B.dot(u))
-
-    def update_step(model: LinearGaussianModel, state, y, idx):
-        x_pred, P_pred = state
-        if idx is None:
-            C, R = model.C, model.R
-        else:
-            C, R = model.C[idx], model.R[np.ix_(idx, idx)]
-        nu = y - C.dot(x_pred)
-        x, P, K, S = correct(x_pred, P_pred, nu, C, R, joseph)
-        return (x, P), Correction(K, nu, S)
-
-    return FilterFamily(
-        name="filtre de Kalman",
-        model_type=LinearGaussianModel,
-        model_hint="pour un modèle non linéaire, utilisez extended_kalman_filter",
-        prior=gaussian_prior,
-        predict=predict_step,
-        update=update_step,
-        moments=gaussian_moments,
-    )
-
-
-# --------------------------------------------------------------------------- tirages en lot
+    return run_filter(kalman_family(form), model, y, x0, P0, u)
 
 
 def kalman_filter_runs(
@@ -233,123 +224,166 @@ def kalman_filter_runs(
     x0: Any,
     P0: Any,
     u: Any = None,
-    joseph: bool = False,
+    *,
+    form: str = FORMS[0],
 ) -> FilterRuns:
-    r"""Filtre de Kalman sur ``N`` tirages à la fois (mêmes équations que :func:`kalman_filter`).
+    r"""Filtre de Kalman sur ``N`` tirages à la fois (mêmes équations que :func:`kalman_filter`), par le
+    mode en lot du moteur (:func:`~kalman_course.filters.engine.run_filter_runs`).
 
-    Sans mesure manquante, la récurrence des covariances :math:`P_{k\mid k-1}, S_k, K_k, P_{k\mid k}` ne
-    dépend pas des mesures : elle est calculée **une fois** pour tous les tirages, et seule la moyenne est
-    propagée en lot, :math:`\hat X_{k\mid k-1} = \hat X_{k-1\mid k-1}A^T + (Bu_k)^T`,
+    Sans mesure manquante et avec un :math:`P_0` commun, la récurrence des covariances
+    :math:`P_{k\mid k-1}, S_k, K_k, P_{k\mid k}` ne dépend pas des mesures : le moteur la calcule **une
+    fois** pour tous les tirages, et seule la moyenne est propagée en lot,
+    :math:`\hat X_{k\mid k-1} = \hat X_{k-1\mid k-1}A^T + (Bu_k)^T`,
     :math:`\hat X_{k\mid k} = \hat X_{k\mid k-1} + (Y_k - \hat X_{k\mid k-1}C^T)K_k^T` (une ligne par
-    tirage). Avec des mesures manquantes (``NaN``, tirage par tirage), chaque tirage garde sa covariance ;
-    à chaque pas, les tirages qui ont le même motif de composantes observées sont corrigés ensemble.
+    tirage). Avec des mesures manquantes (``NaN``, tirage par tirage) ou un :math:`P_0` par tirage, chaque
+    tirage garde sa covariance ; à chaque pas, les tirages qui ont le même motif de composantes observées
+    sont corrigés ensemble.
 
     Paramètres
     ----------
     model : LinearGaussianModel
-    Y : (N, T, m), ou (N, T) si m = 1 — mesures des ``N`` tirages ; ``NaN`` : composante manquante.
-    x0 : (n,) commun (scalaire si n = 1), ou (N, n) un par tirage. P0 : (n, n) commun.
-    u : (T, p) commun, ou (N, T, p), optionnel.
-    joseph : forme de Joseph pour la covariance a posteriori.
+    Y : (N, T, m) — mesures des ``N`` tirages ; ``NaN`` : composante manquante. Un tableau 2-D est refusé.
+    x0 : (n,) commun (scalaire si n = 1), ou (N, n) un par tirage.
+    P0 : (n, n) commune, ou (N, n, n) une par tirage.
+    u : (T, p) commune, ou (N, T, p) une par tirage, optionnel.
+    form : comme :func:`kalman_filter`.
 
     Renvoie un :class:`~kalman_course.core.results.FilterRuns` : ``x`` (N, T, n), ``innovation``
     (N, T, m)… et ``P``, ``P_pred``, ``K``, ``S`` de forme (T, …) s'ils sont communs (aucune mesure
-    manquante), (N, T, …) sinon. Chaque tirage est égal à :func:`kalman_filter` sur ses mesures.
+    manquante, :math:`P_0` commune), (N, T, …) sinon. Chaque tirage est égal à :func:`kalman_filter` sur
+    ses mesures.
     """
-    model = check_instance("model", model, LinearGaussianModel, "pour un modèle non linéaire, bouclez sur extended_kalman_filter")
-    n, m = model.n_state, model.n_obs
-    Yarr = as_batch_measurements("Y", Y, m)
-    N, T, _ = Yarr.shape
-    X0 = as_batch_vector("x0", x0, n, N)
-    P = check_psd("P0", as_square_matrix("P0", P0, n))
-    BU = _batch_controls(model, u, N, T)  # None, (T, n) ou (N, T, n)
-    observed = ~np.isnan(Yarr)
-    A, C, Q, R = model.A, model.C, model.Q, model.R
-
-    X = X0
-    xs, xps = np.empty((N, T, n)), np.empty((N, T, n))
-    nus = np.full((N, T, m), np.nan)
-    if observed.all():
-        Ps, Pps, Ks, Ss = np.empty((T, n, n)), np.empty((T, n, n)), np.empty((T, n, m)), np.empty((T, m, m))
-        for k in range(T):
-            Xp = X.dot(A.T)
-            if BU is not None:
-                Xp += BU[..., k, :]
-            P_pred = symmetrize(A.dot(P).dot(A.T) + Q)
-            K, S, PCt = kalman_gain(P_pred, C, R, f"au pas {k}")
-            nu = Yarr[:, k] - Xp.dot(C.T)
-            X = Xp + nu.dot(K.T)
-            if joseph:
-                IKC = np.eye(n) - K.dot(C)
-                P = symmetrize(IKC.dot(P_pred).dot(IKC.T) + K.dot(R).dot(K.T))
-            else:
-                P = symmetrize(P_pred - K.dot(PCt.T))
-            xps[:, k], xs[:, k], nus[:, k] = Xp, X, nu
-            Pps[k], Ps[k], Ks[k], Ss[k] = P_pred, P, K, S
-        n_iter = np.ones((N, T), dtype=int)
-        return FilterRuns(x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss,
-                          observed=observed, n_iter=n_iter)
-
-    Ps, Pps = np.empty((N, T, n, n)), np.empty((N, T, n, n))
-    Ks, Ss = np.zeros((N, T, n, m)), np.full((N, T, m, m), np.nan)
-    n_iter = np.zeros((N, T), dtype=int)
-    Pr = np.broadcast_to(P, (N, n, n)).copy()
-    for k in range(T):
-        Xp = X.dot(A.T)
-        if BU is not None:
-            Xp += BU[..., k, :]
-        Pp = symmetrize(A @ Pr @ A.T + Q)
-        X, Pr = Xp.copy(), Pp.copy()
-        patterns, group = np.unique(observed[:, k], axis=0, return_inverse=True)
-        for g, pattern in enumerate(patterns):
-            if not pattern.any():
-                continue
-            runs = np.flatnonzero(group.ravel() == g)
-            idx = np.flatnonzero(pattern)
-            Ck, Rk = C[idx], R[np.ix_(idx, idx)]
-            PCt = Pp[runs] @ Ck.T                                  # (g, n, q)
-            S = Ck @ PCt + Rk                                      # (g, q, q)
-            K = np.swapaxes(_batched_solve_pd(S, np.swapaxes(PCt, 1, 2), k), 1, 2)  # (g, n, q)
-            nu = Yarr[runs, k][:, idx] - Xp[runs] @ Ck.T           # (g, q)
-            X[runs] = Xp[runs] + np.einsum("gij,gj->gi", K, nu)
-            if joseph:
-                IKC = np.eye(n) - K @ Ck
-                Pr[runs] = symmetrize(IKC @ Pp[runs] @ np.swapaxes(IKC, 1, 2) + K @ Rk @ np.swapaxes(K, 1, 2))
-            else:
-                Pr[runs] = symmetrize(Pp[runs] - K @ np.swapaxes(PCt, 1, 2))
-            for j, r in enumerate(runs):
-                Ks[r, k][:, idx] = K[j]
-                Ss[r, k][np.ix_(idx, idx)] = S[j]
-                nus[r, k, idx] = nu[j]
-            n_iter[runs, k] = 1
-        xps[:, k], xs[:, k], Pps[:, k], Ps[:, k] = Xp, X, Pp, Pr
-    return FilterRuns(x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss,
-                      observed=observed, n_iter=n_iter)
+    return run_filter_runs(kalman_family(form), model, Y, x0, P0, u)
 
 
-def _batched_solve_pd(S: np.ndarray, B: np.ndarray, k: int) -> np.ndarray:
-    """Résout :math:`S_j X_j = B_j` pour une pile de matrices définies positives (Cholesky)."""
-    try:
-        L = np.linalg.cholesky(S)
-    except np.linalg.LinAlgError:
-        raise KalmanInputError(f"{S_NOT_PD[:-1]} (au pas {k}).") from None
-    Z = np.linalg.solve(L, B)
-    return np.linalg.solve(np.swapaxes(L, 1, 2), Z)
+def _gram(M: np.ndarray) -> np.ndarray:
+    r""":math:`M^TM` (…, n, n) d'une racine ``M`` (…, r, n) : la covariance qu'elle porte (exactement symétrique)."""
+    return M.T.dot(M) if M.ndim == 2 else np.swapaxes(M, -1, -2) @ M
 
 
-def _batch_controls(model: LinearGaussianModel, u: Any, N: int, T: int) -> np.ndarray | None:
-    """Termes :math:`Bu` : ``None``, (T, n) communs ou (N, T, n)."""
-    if u is None:
-        return None
-    check_control_allowed("u", model.n_control)
-    p = model.n_control
-    U = as_float_array("u", u)
-    if U.ndim == 1 and p == 1:
-        U = U[:, None]
-    if U.ndim == 2 and U.shape == (T, p):
-        return U @ model.B.T
-    if U.ndim == 3 and U.shape == (N, T, p):
-        return U @ model.B.T
-    raise KalmanInputError(
-        f"« u » doit être de forme ({T}, {p}) (commune) ou ({N}, {T}, {p}) (une par tirage) ; reçu {shape_text(U.shape)}."
+def _predicted_root(U: np.ndarray, A: np.ndarray, U_Q: np.ndarray) -> np.ndarray:
+    r"""Racine de :math:`P^- = AP A^T + Q` à partir d'une racine ``U`` (…, r, n) de :math:`P` : les racines
+    empilées :math:`[UA^T; U_Q]` ((r + n) × n), que la QR de la correction triangularisera (une QR par pas au
+    lieu de deux). Une racine de plus de ``n`` lignes (le pas précédent était sans mesure) est d'abord
+    triangularisée ; les racines d'une pile de tirages (N, r, n) le sont aussitôt (une seule forme pour
+    toute la pile, quel que soit le motif des mesures manquantes)."""
+    n = A.shape[0]
+    if U.shape[-2] > n:
+        U = triangular_root(U)
+    if U.ndim == 2:
+        return np.concatenate((U.dot(A.T), U_Q))
+    return triangular_root(np.concatenate([U @ A.T, np.broadcast_to(U_Q, U.shape)], axis=-2))
+
+
+def _observed_part(model: LinearGaussianModel, idx: np.ndarray | None, square_root: bool):
+    r""":math:`C` et :math:`R` (ou la racine :math:`U_R`) restreintes aux composantes observées ``idx``
+    (``None`` : toutes)."""
+    if idx is None:
+        return model.C, (model.noise_roots[1] if square_root else model.R)
+    R = model.R[np.ix_(idx, idx)]
+    return model.C[idx], (covariance_root(R) if square_root else R)
+
+
+def kalman_family(form: str = FORMS[0]) -> FilterFamily:
+    r"""Les étapes du filtre de Kalman linéaire pour le moteur, un tirage
+    (:func:`~kalman_course.filters.engine.run_filter`) ou ``N`` à la fois
+    (:func:`~kalman_course.filters.engine.run_filter_runs`).
+
+    État interne :math:`(\hat x, P, M)` pour ``form="square_root"`` — la racine :math:`M` (:math:`M^TM = P`)
+    porte le calcul, :math:`P` est lue sur elle à chaque pas pour le résultat — et :math:`(\hat x, P)` pour
+    les deux autres formes. Étapes en lot : la moyenne a une ligne par tirage (N, n), la covariance et sa
+    racine sont communes à tous les tirages (n, n) (Riccati commune) ou une par tirage (N, n, n) ; la
+    commande est (p,) ou (N, p)."""
+    form = _check_form(form)
+    square_root, joseph = form == "square_root", form == "joseph"
+
+    def predict_mean(model, x, u):  # x̂⁻ = A x̂ + B u ; x (n,) ou une ligne par tirage (N, n)
+        x_pred = x.dot(model.A.T)
+        if u is not None:
+            x_pred += u.dot(model.B.T)
+        return x_pred
+
+    if square_root:
+        def prior(model, x0, P0):
+            x, P = gaussian_prior(model, x0, P0)
+            return x, P, covariance_root(P)
+
+        def prior_many(model, x0, P0, N, shared=False):
+            X, P = gaussian_prior_many(model, x0, P0, N, shared=shared)
+            return X, P, covariance_root(P)
+
+        def predict(model, state, u):  # un tirage
+            x, _, U = state
+            A = model.A
+            if U.shape[0] > A.shape[0]:  # le pas précédent était sans mesure : racine rectangulaire
+                U = triangular_root(U)
+            M = np.concatenate((U.dot(A.T), model.noise_roots[0]))
+            return (A.dot(x) if u is None else A.dot(x) + model.B.dot(u)), M.T.dot(M), M
+
+        def update(model, state, y, idx):
+            x_pred, _, M = state
+            C, U_R = _observed_part(model, idx, True)
+            nu = y - C.dot(x_pred)
+            x, U, K, U_S = correct_square_root(x_pred, M, nu, C, U_R)
+            return (x, U.T.dot(U), U), Correction(K, nu, U_S.T.dot(U_S))
+
+        def predict_many(model, state, u, k):
+            X, _, U = state
+            M = _predicted_root(U, model.A, model.noise_roots[0])
+            return predict_mean(model, X, u), _gram(M), M
+
+        def update_many(model, state, Y, idx, k):
+            X_pred, _, M = state
+            C, U_R = _observed_part(model, idx, True)
+            nu = Y - X_pred.dot(C.T)
+            X, U, K, U_S = correct_square_root(X_pred, M, nu, C, U_R, f"correction par y[{k}]")
+            return (X, _gram(U), U), Correction(K, nu, _gram(U_S))
+    else:
+        prior = gaussian_prior
+
+        def prior_many(model, x0, P0, N, shared=False):
+            return gaussian_prior_many(model, x0, P0, N, shared=shared)
+
+        def predict(model, state, u):  # un tirage : le noyau montré dans le chapitre « prédicteur-correcteur »
+            x, P = state
+            return _predict(x, P, model.A, model.Q, None if u is None else model.B.dot(u))
+
+        def update(model, state, y, idx):
+            x_pred, P_pred = state
+            C, R = _observed_part(model, idx, False)
+            nu = y - C.dot(x_pred)
+            x, P, K, S = correct(x_pred, P_pred, nu, C, R, joseph)
+            return (x, P), Correction(K, nu, S)
+
+        def predict_many(model, state, u, k):
+            X, P = state
+            A = model.A
+            return predict_mean(model, X, u), symmetrize((A.dot(P).dot(A.T) if P.ndim == 2 else A @ P @ A.T) + model.Q)
+
+        def update_many(model, state, Y, idx, k):
+            X_pred, P_pred = state
+            C, R = _observed_part(model, idx, False)
+            nu = Y - X_pred.dot(C.T)
+            where = f"correction par y[{k}]"
+            if P_pred.ndim == 2:  # covariance commune : un gain pour tous les tirages
+                K, S, PCt = kalman_gain(P_pred, C, R, where)
+                IKC = np.eye(P_pred.shape[0]) - K.dot(C)
+                P = IKC.dot(P_pred).dot(IKC.T) + K.dot(R).dot(K.T) if joseph else P_pred - K.dot(PCt.T)
+                return (X_pred + nu.dot(K.T), symmetrize(P)), Correction(K, nu, S)
+            X, P, K, S = correct_many(X_pred, P_pred, nu, C, R, joseph, where)
+            return (X, P), Correction(K, nu, S)
+
+    return FilterFamily(
+        name="filtre de Kalman",
+        model_type=LinearGaussianModel,
+        model_hint="pour un modèle non linéaire, utilisez extended_kalman_filter",
+        prior=prior,
+        predict=predict,
+        update=update,
+        moments=gaussian_moments,
+        prior_many=prior_many,
+        predict_many=predict_many,
+        update_many=update_many,
+        batch_controls=True,
+        shared_covariance=True,
     )

@@ -6,8 +6,8 @@ pas :math:`\Delta t = 1` s, accélération blanche :math:`\sigma_a` (bruit d'ét
 
 Sans a priori, l'estimation exacte après :math:`k` relevés est la solution des moindres carrés pondérés
 sur toutes les inconnues (:func:`batch_estimates`, indépendante de tout filtre). Le SRIF part de
-:math:`\mathcal R_{xx} = 0` et la retrouve ; le filtre de Kalman doit simuler l'absence d'a priori par
-:math:`P_0 = 10^k I`, ce qui biaise l'estimation si :math:`P_0` est trop petite et la noie dans les
+:math:`\mathcal R_{xx} = 0` et la retrouve ; le filtre de Kalman sous la forme du cours
+(``form="textbook"``, :math:`P = P^- - KCP^-`) doit simuler l'absence d'a priori par :math:`P_0 = 10^k I`, ce qui biaise l'estimation si :math:`P_0` est trop petite et la noie dans les
 arrondis si elle est trop grande (:func:`diffuse_errors`). La référence de :func:`diffuse_errors` est
 calculée en précision étendue (:func:`extended_precision_estimates`, 120 chiffres décimaux).
 """
@@ -225,7 +225,7 @@ def _position_gap(x: np.ndarray, ref: np.ndarray) -> np.ndarray:
 
 
 def diffuse_errors(exponents=DIFFUSE_P0_EXPONENTS) -> DiffuseErrors:
-    r"""Filtre de Kalman avec :math:`\hat x_0 = 0`, :math:`P_0 = 10^kI` pour chaque ``k``, et SRIF sans
+    r"""Filtre de Kalman (forme du cours) avec :math:`\hat x_0 = 0`, :math:`P_0 = 10^kI` pour chaque ``k``, et SRIF sans
     a priori, comparés à :func:`extended_precision_estimates` sur les relevés de :func:`diffuse_data`."""
     model = diffuse_model()
     _, y = diffuse_data()
@@ -235,7 +235,7 @@ def diffuse_errors(exponents=DIFFUSE_P0_EXPONENTS) -> DiffuseErrors:
     failed = np.zeros(len(exponents), dtype=bool)
     for i, e in enumerate(exponents):
         try:
-            kf[i] = _position_gap(kalman_filter(model, y, np.zeros(4), 10.0**e * np.eye(4)).x, ref)
+            kf[i] = _position_gap(kalman_filter(model, y, np.zeros(4), 10.0**e * np.eye(4), form="textbook").x, ref)
         except KalmanInputError:
             failed[i] = True
     return DiffuseErrors(np.array(exponents, dtype=float), kf, failed, _position_gap(srif.x, ref), ref)
