@@ -284,7 +284,7 @@ def log_likelihoods(models: Any, y: Any) -> np.ndarray:
         WE = W[:, :, 1:]  # -L⁻¹E
         J += np.swapaxes(WE, 1, 2) @ WE
         h -= (np.swapaxes(WE, 1, 2) @ w[:, :, None])[:, :, 0]
-        Kt = np.linalg.solve(S, np.swapaxes(PCt, 1, 2))  # Kᵀ = S⁻¹CP⁻
+        Kt = np.linalg.solve(np.swapaxes(L, 1, 2), np.linalg.solve(L, np.swapaxes(PCt, 1, 2)))  # Kᵀ = S⁻¹CP⁻ par Cholesky
         K = np.swapaxes(Kt, 1, 2)
         xa = xa + K @ V
         P = symmetrize(P - K @ np.swapaxes(PCt, 1, 2))
@@ -533,6 +533,26 @@ class EMResult:
                 f"{'convergé' if self.converged else 'non convergé'}>")
 
 
+def _initial_noise_moment(model: LinearGaussianModel, res: FilterResult, x_smooth: np.ndarray,
+                          P_smooth: np.ndarray) -> np.ndarray:
+    r""":math:`\mathbb E[w_1w_1^T \mid y]` du premier bruit d'état :math:`w_1 = x_1 - Ax_0 - Bu_1`, par le
+    lissage des bruits (Durbin & Koopman 2012, § 4.5) :
+
+    .. math::
+
+        \mathbb E[w_1 \mid y] = QP_{1\mid 0}^{-1}(\hat x_{1\mid T} - \hat x_{1\mid 0}),\qquad
+        \operatorname{Cov}(w_1 \mid y) = Q - QP_{1\mid 0}^{-1}Q + QP_{1\mid 0}^{-1}P_{1\mid T}P_{1\mid 0}^{-1}Q .
+
+    Même valeur que :math:`r_1r_1^T + P_{1\mid T} - P_{1,0\mid T}A^T - AP_{1,0\mid T}^T + AP_{0\mid T}A^T`
+    avec l'état initial lissé, mais sans :math:`P_{0\mid T} = P_0 - G_0(P_{1\mid 0} - P_{1\mid T})G_0^T`, qui
+    soustrait des nombres de l'ordre de :math:`P_0` et perd tous ses chiffres quand l'a priori est vague
+    (:math:`P_0 = 10^{14}I`) : ici :math:`P_{1\mid 0}` n'apparaît qu'inversée."""
+    Q = model.Q
+    W = scipy.linalg.lstsq(res.P_pred[0], Q)[0]  # P⁻⁻¹Q (moindres carrés : P⁻ = AP0Aᵀ + Q peut être singulière)
+    w = W.T.dot(x_smooth - res.x_pred[0])
+    return np.outer(w, w) + Q - Q.dot(W) + W.T.dot(P_smooth).dot(W)
+
+
 def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.ndarray | None):
     r"""Une itération d'EM : filtre, lisseur (étape E), formules closes (étape M).
 
@@ -545,8 +565,9 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
 
         R' = \frac1T\sum_k \Big[e_ke_k^T + CP_{k\mid T}C^T\Big],\quad e_k = y_k - C\hat x_{k\mid T},
 
-    la somme sur :math:`Q` portant sur les :math:`N_Q` transitions (depuis l'état initial lissé si
-    l'a priori est connu ; à partir de la deuxième mesure au départ diffus). Pour une mesure
+    la somme sur :math:`Q` portant sur les :math:`N_Q` transitions (depuis l'état initial si l'a priori est
+    connu, terme calculé par le lissage des bruits, :func:`_initial_noise_moment`, sûr pour un a priori
+    vague ; à partir de la deuxième mesure au départ diffus). Pour une mesure
     manquante, le terme de :math:`R'` est son espérance sachant les composantes observées :
     :math:`R` lui-même si tout manque, sinon
     :math:`M(e_oe_o^T + C_oPC_o^T)M^T + \operatorname{diag}(0, R_{mm} - R_{mo}R_{oo}^{-1}R_{om})`,
@@ -563,29 +584,26 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
     if _prior(x0, P0):
         res = kalman_filter(model, Y, x0, P0, U)
         ll = filter_log_likelihood(res)
-        sm = rts_smoother(model, res, x0, P0)
-        xs, Ps, lag, x_initial, P_initial = sm.x, sm.P, sm.P_lag, sm.x_initial, sm.P_initial
+        sm = rts_smoother(model, res)
+        xs, Ps, lag, known_prior = sm.x, sm.P, sm.P_lag, True
     else:
         augmented = run_filter(diffuse_family(), model, Y, None, None, U)
         J, h = diffuse_information(model, augmented)
         ll = _diffuse_value(augmented, J[-1], h[-1])  # vérifie que J_T est inversible
         xs, Ps, lag = diffuse_rts_pass(model.A, augmented, J[-1], h[-1])
-        x_initial = P_initial = None
+        known_prior = False
     A, C, R = model.A, model.C, model.R
     T, m = Y.shape
     Bu = np.zeros_like(xs) if U is None else U @ model.B.T
-    # transitions k-1 → k, k = 1…T-1 (et 0 depuis l'état initial si l'a priori est connu)
-    prev_x, prev_P = xs[:-1], Ps[:-1]
-    cur_x, cur_P, cur_lag, cur_Bu = xs[1:], Ps[1:], lag[1:], Bu[1:]
-    if x_initial is not None:
-        prev_x = np.concatenate([x_initial[None], prev_x])
-        prev_P = np.concatenate([P_initial[None], prev_P])
-        cur_x, cur_P, cur_lag, cur_Bu = xs, Ps, lag, Bu
-    if cur_x.shape[0] == 0:
+    # transitions k-1 → k, k = 1…T-1 : E[w wᵀ | y] = r rᵀ + P_{k|T} − P_{k,k-1|T}Aᵀ − A P_{k,k-1|T}ᵀ + A P_{k-1|T} Aᵀ
+    if xs.shape[0] < 2 and not known_prior:
         raise KalmanInputError("Il faut au moins deux pas de mesure pour estimer Q par EM sans a priori.")
-    r = cur_x - prev_x @ A.T - cur_Bu
-    LA = cur_lag @ A.T
-    Q_new = np.mean(r[:, :, None] * r[:, None, :] + cur_P - LA - np.swapaxes(LA, 1, 2) + A @ prev_P @ A.T, axis=0)
+    r = xs[1:] - xs[:-1] @ A.T - Bu[1:]
+    LA = lag[1:] @ A.T
+    terms_Q = r[:, :, None] * r[:, None, :] + Ps[1:] - LA - np.swapaxes(LA, 1, 2) + A @ Ps[:-1] @ A.T
+    if known_prior:  # et la transition 0 → 1 depuis l'a priori
+        terms_Q = np.concatenate([_initial_noise_moment(model, res, xs[0], Ps[0])[None], terms_Q])
+    Q_new = np.mean(terms_Q, axis=0)
     # mesures
     obs = ~np.isnan(Y)
     terms = np.empty((T, m, m))

@@ -452,3 +452,29 @@ def test_em_fast_e_step_equals_the_public_filter_and_smoother(missing):
         R_ref = np.mean((y - sm.x[:, 0]) ** 2 + sm.P[:, 0, 0])
         assert new.Q[0, 0] == pytest.approx(Q_ref, rel=1e-10)
         assert new.R[0, 0] == pytest.approx(R_ref, rel=1e-10)
+
+
+# --------------------------------------------------------------------------- a priori vague
+
+
+def test_vague_prior_likelihood_em_and_monte_carlo_run_and_tend_to_the_diffuse_limit():
+    """P₀ = 10¹⁰ I à 10¹⁴ I sur la vitesse constante au millimètre (Q de rang 2) : log L + (n/2) log κ tend vers
+    la vraisemblance diffuse exacte (Durbin & Koopman : L_d = lim κ^{n/2} L_κ, det A = 1) ; EM tourne,
+    ne décroît jamais, et son Q ne dépend plus de κ (à 10⁻⁶ près, relatif) ; le Monte-Carlo en lot tourne."""
+    import math
+
+    model, y = kc.scenarios.diffuse.diffuse_model(), kc.scenarios.diffuse.diffuse_data()[1]
+    diffuse = kc.log_likelihood(model, y)
+    Qs = []
+    for exponent in (10, 12, 14):
+        kappa = 10.0**exponent
+        ll = kc.log_likelihood(model, y, np.zeros(4), kappa * np.eye(4))
+        assert abs(ll + 2.0 * math.log(kappa) - diffuse) < 1e-4
+        em = kc.expectation_maximization(model, y, np.zeros(4), kappa * np.eye(4), max_iter=15)
+        assert np.all(np.diff(em.history) >= -1e-9 * np.abs(em.history[1:]))
+        Qs.append(em.model.Q)
+        mc = kc.monte_carlo(model, None, 20, 50, x0_mean=np.zeros(4), x0_cov=np.eye(4), x0_hat=np.zeros(4),
+                            P0=kappa * np.eye(4), rng=1)
+        assert np.isfinite(mc.x_hat).all()
+    for Q in Qs[1:]:
+        np.testing.assert_allclose(Q, Qs[0], rtol=0, atol=1e-6 * np.abs(Qs[0]).max())

@@ -447,3 +447,48 @@ def test_unscented_smoother_refuses_other_parameters_or_filters():
     ekf = kc.extended_kalman_filter(model, data.y, data.x0, data.P0)
     with pytest.raises(kc.KalmanInputError, match="ne vient pas du filtre de Kalman sans parfum"):
         kc.unscented_rts_smoother(model, ekf, alpha=0.5, kappa=0.0)
+
+
+# --------------------------------------------------------------------------- a priori vague
+
+
+@pytest.mark.parametrize("exponent", [10, 12, 14])
+def test_vague_prior_smoother_reaches_the_exact_diffuse_smoother(exponent):
+    """Lisseur de RTS en racine carrée : parti d'un filtre à a priori vague (P₀ = 10ᵏ I), il retrouve le lissage
+    diffus exact (vérifié contre statsmodels ci-dessus) à toutes les lignes, la première comprise (son
+    P_{0|T} exige la différence de deux nombres de l'ordre de P₀ sous la forme usuelle), de même que les
+    covariances de décalage un (EM)."""
+    model, y = kc.scenarios.diffuse.diffuse_model(), kc.scenarios.diffuse.diffuse_data()[1]
+    exact = kc.rts_smoother(model, kc.diffuse_kalman_filter(model, y))
+    sm = kc.rts_smoother(model, kc.kalman_filter(model, y, np.zeros(4), 10.0**exponent * np.eye(4)))
+    np.testing.assert_allclose(sm.x, exact.x, rtol=0, atol=1e-9)
+    scale = np.abs(exact.P).max()
+    np.testing.assert_allclose(sm.P, exact.P, rtol=0, atol=1e-6 * scale)
+    np.testing.assert_allclose(sm.P_lag[1:], exact.P_lag[1:], rtol=0, atol=1e-6 * scale)
+    # la forme usuelle (gains par résolution, P_{k|T} = P_k + G(P_{k+1|T} − P⁻_{k+1})Gᵀ) perd P_{0|T}
+    from kalman_course.filters.smoothers import rts_pass, smoother_gains
+
+    res = kc.kalman_filter(model, y, np.zeros(4), 10.0**exponent * np.eye(4))
+    G = np.zeros_like(res.P)
+    G[:-1] = smoother_gains(res.P[:-1], res.P_pred[1:], model.A)
+    _, Ps, _ = rts_pass(res.x, res.P, res.x_pred, res.P_pred, G)
+    assert np.abs(Ps[0] - exact.P[0]).max() > 1e-3 * np.abs(exact.P[0]).max()
+
+
+@pytest.mark.parametrize("exponent, rtol", [(12, 1e-5), (14, 1e-4)])
+def test_vague_prior_initial_state_is_smoothed_to_the_batch_posterior(exponent, rtol):
+    """L'état initial lissé (instant 0) sous un a priori vague : le postérieur exact en bloc (dense_oracle,
+    indépendant des filtres) avec le même a priori. Mesuré : écart relatif 8 × 10⁻⁷ (10¹²) et 3 × 10⁻⁵ (10¹⁴),
+    limité par la covariance filtrée P[0] rangée dans le résultat ; la forme usuelle
+    P₀ + G₀(P_{1|T} − P⁻₁)G₀ᵀ s'écarte de 1,3 × 10⁻⁴ et 8 × 10⁻³."""
+    rng = np.random.default_rng(5)
+    A = np.array([[0.9, 0.2, 0.0], [0.0, 0.8, 0.3], [0.1, 0.0, 0.7]])
+    model = kc.LinearGaussianModel(A, rng.standard_normal((2, 3)), 0.1 * np.eye(3), np.diag([0.5, 0.2]))
+    y = kc.simulate(model, np.ones(3), 12, rng=4).y
+    P0 = 10.0**exponent * np.eye(3)
+    sm = kc.rts_smoother(model, kc.kalman_filter(model, y, np.zeros(3), P0), np.zeros(3), P0)
+    ref = batch_posterior(model, y, x0=np.zeros(3), P0=P0)
+    scale = np.abs(ref["P_initial"]).max()
+    np.testing.assert_allclose(sm.x_initial, ref["x_initial"], rtol=0, atol=rtol * np.abs(ref["x_initial"]).max())
+    np.testing.assert_allclose(sm.P_initial, ref["P_initial"], rtol=0, atol=rtol * scale)
+    np.testing.assert_allclose(sm.P_lag[0], ref["lag0"], rtol=0, atol=rtol * scale)

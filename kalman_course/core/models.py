@@ -335,19 +335,23 @@ class NonlinearModel:
         V = self.measurement_noise_gain(x)
         return V.dot(self.R).dot(V.T)
 
+    def observed_angles(self, idx: np.ndarray | None = None) -> list[int]:
+        r"""Positions des composantes angulaires (``angle_indices``) dans une mesure réduite aux composantes
+        observées ``idx`` (indices dans la mesure complète ; ``None`` : toutes) — la seule traduction
+        « indice de mesure → position dans la mesure observée » du paquet."""
+        if idx is None or not self.angle_indices:
+            return list(self.angle_indices)
+        return [j for j, i in enumerate(idx) if int(i) in self.angle_indices]
+
     def residual(self, y: np.ndarray, y_hat: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:
         r"""Résidu :math:`y - \hat y`, les composantes angulaires ramenées dans :math:`(-\pi, \pi]`.
 
-        ``idx`` : indices (dans la mesure complète) des composantes que contiennent ``y`` et ``y_hat``
-        quand la mesure est partielle (``None`` : toutes)."""
+        ``y``, ``y_hat`` (…, m_k) ; ``idx`` : indices (dans la mesure complète) des composantes qu'ils
+        contiennent quand la mesure est partielle (``None`` : toutes)."""
         d = np.asarray(y - y_hat, dtype=float)
-        if self.angle_indices:
-            if idx is None:
-                angles = list(self.angle_indices)
-            else:
-                angles = [j for j, i in enumerate(idx) if int(i) in self.angle_indices]
-            if angles:
-                d[angles] = wrap_angle(d[angles])
+        angles = self.observed_angles(idx)
+        if angles:
+            d[..., angles] = wrap_angle(d[..., angles])
         return d
 
     @classmethod

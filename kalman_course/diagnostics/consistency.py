@@ -27,6 +27,7 @@ import numpy as np
 import scipy.linalg
 import scipy.stats
 
+from ..core.linalg import psd_solve
 from ..core.results import FilterResult, FilterRuns, freeze_fields
 from ..core.simulation import check_positive_int
 from ..tables import Table
@@ -552,12 +553,8 @@ def centring_test(innovations: Any, *, level: float = 0.95) -> CentringTest:
         )
     mean = e.mean(axis=0)
     W = np.atleast_2d(np.cov(e, rowvar=False, ddof=1))
-    try:
-        t2 = float(N * mean @ scipy.linalg.solve(W, mean, assume_a="pos"))
-    except np.linalg.LinAlgError:
-        raise KalmanInputError(
-            "« innovations » : covariance empirique singulière (composantes constantes ou liées)."
-        ) from None
+    t2 = float(N * mean @ psd_solve(W, mean, message="« innovations » : covariance empirique singulière "
+                                                   "(composantes constantes ou liées)."))
     f_stat = (N - m) / (m * (N - 1)) * t2
     p = float(scipy.stats.f.sf(f_stat, m, N - m))
     t = scipy.stats.ttest_1samp(e, 0.0, axis=0)

@@ -48,7 +48,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.linalg import correct, symmetrize
+from ..core.linalg import correct, psd_solve, symmetrize
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult
 from .engine import Correction, FilterFamily, gaussian_moments, run_filter
@@ -193,7 +193,7 @@ def diffuse_information(model: LinearGaussianModel, augmented: FilterResult):
     obs = np.asarray(augmented.observed, dtype=bool)
     E = np.where(obs[:, :, None], model.C[None] @ augmented.x_pred[:, :, 1:], 0.0)  # (T, m, n)
     v, S = masked_innovations(augmented.innovation, augmented.S, obs)
-    SiE = np.linalg.solve(S, E)  # S⁻¹E par résolution (jamais d'inverse explicite)
+    SiE = psd_solve(S, E)  # S⁻¹E par Cholesky (jamais d'inverse explicite)
     J = np.cumsum(np.swapaxes(E, 1, 2) @ SiE, axis=0)
     h = np.cumsum(np.einsum("tmn,tm->tn", SiE, v), axis=0)
     return symmetrize(J).reshape(-1, n, n), h
@@ -207,7 +207,7 @@ def _collapse(xa: np.ndarray, P: np.ndarray, J: np.ndarray, h: np.ndarray, ok: n
     if ok.any():
         X = xa[ok][:, :, 1:]
         rhs = np.concatenate([h[ok][:, :, None], np.swapaxes(X, 1, 2)], axis=2)  # [h | Xᵀ]
-        sol = np.linalg.solve(J[ok], rhs)
+        sol = psd_solve(J[ok], rhs, message="L'information J sur l'état initial n'est pas définie positive.", name="J")
         x_out[ok] = xa[ok][:, :, 0] + (X @ sol[:, :, :1])[:, :, 0]
         P_out[ok] = symmetrize(P[ok] + X @ sol[:, :, 1:])
     return x_out, P_out
@@ -258,7 +258,7 @@ def diffuse_kalman_filter(model: LinearGaussianModel, y: Any, u: Any = None) -> 
         nu = np.where(o, augmented.innovation[rows], 0.0) - (C_o @ shift[:, :, None])[:, :, 0]
         S_rows = C_o @ P_pred[rows] @ np.swapaxes(C_o, 1, 2) + model.R
         _, S_solve = masked_innovations(nu, S_rows, o)
-        K[rows] = np.swapaxes(np.linalg.solve(S_solve, C_o @ P_pred[rows]), 1, 2)
+        K[rows] = np.swapaxes(psd_solve(S_solve, C_o @ P_pred[rows]), 1, 2)
         both = o[:, :, None] & o[:, None, :]
         innovation[rows] = np.where(o, nu, np.nan)
         S[rows] = np.where(both, symmetrize(S_rows), np.nan)

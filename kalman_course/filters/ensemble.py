@@ -29,10 +29,9 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
-import scipy.linalg
 
 from ..core.angles import wrap_angle
-from ..core.linalg import centred_rows, covariance_factor, symmetrize
+from ..core.linalg import centred_rows, covariance_factor, psd_solve, symmetrize
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult
 from ..core.simulation import check_positive_int
@@ -41,9 +40,6 @@ from .engine import Correction, FilterFamily, run_filter
 from .extended import NONLINEAR_HINT
 
 __all__ = ["EnsembleFilterResult", "ensemble_family", "ensemble_kalman_filter"]
-
-_posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
-
 
 @dataclass(frozen=True, eq=False, repr=False)
 class EnsembleFilterResult(FilterResult):
@@ -75,14 +71,6 @@ def _moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x, symmetrize(D.T.dot(D) / (X.shape[0] - 1)), D
 
 
-def _angles(model: NonlinearModel, idx) -> list[int]:
-    if not model.angle_indices:
-        return []
-    if idx is None:
-        return list(model.angle_indices)
-    return [j for j, i in enumerate(idx) if int(i) in model.angle_indices]
-
-
 def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = True) -> FilterFamily:
     r"""Les étapes de l'EnKF stochastique pour le moteur (famille ``stochastic``) ; ``perturb=False``
     retire les perturbations :math:`v^i` des observations (pour montrer pourquoi elles sont nécessaires)."""
@@ -112,7 +100,7 @@ def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = 
         if idx is not None:
             HX, R = HX[:, idx], R[np.ix_(idx, idx)]
             LR = np.linalg.cholesky(R)
-        angles = _angles(model, idx)
+        angles = model.observed_angles(idx)
         x_bar, _, dX = state.moments or _moments(X)  # moyenne et écarts de l'ensemble prévu
         y_bar = HX.mean(axis=0)
         if angles:
@@ -122,12 +110,8 @@ def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = 
             dY[:, angles] = wrap_angle(dY[:, angles])
         Pxy = dX.T.dot(dY) / (N - 1)
         S = dY.T.dot(dY) / (N - 1) + R
-        _, Kt, info = _posv(S, Pxy.T)
-        if info != 0:
-            raise KalmanInputError(
-                f"EnKF, analyse par y[{state.k}] : la covariance d'innovation P_yy + R n'est pas définie positive."
-            )
-        K = Kt.T
+        K = psd_solve(S, Pxy.T, message=f"EnKF, analyse par y[{state.k}] : la covariance d'innovation P_yy + R "
+                                         "n'est pas définie positive.").T
         D = y - HX
         if perturb:
             D = D + rng.standard_normal((N, R.shape[0])).dot(LR.T)

@@ -25,7 +25,6 @@ from typing import Any
 
 import numpy as np
 
-from ..core.angles import wrap_angle
 from ..core.linalg import correct, correct_many, symmetrize
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, FilterRuns
@@ -170,12 +169,7 @@ def measurement_noises(model: NonlinearModel, X: np.ndarray, idx: np.ndarray | N
 def residuals(model: NonlinearModel, Y: np.ndarray, Y_hat: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:
     r"""Résidus :math:`y_i - \hat y_i` d'une pile (N, m_k), composantes angulaires ramenées dans
     :math:`(-\pi, \pi]` (``idx`` : composantes observées, comme :meth:`NonlinearModel.residual`)."""
-    d = np.asarray(Y - Y_hat, dtype=float)
-    if model.angle_indices:
-        angles = list(model.angle_indices) if idx is None else [j for j, i in enumerate(idx) if int(i) in model.angle_indices]
-        if angles:
-            d[..., angles] = wrap_angle(d[..., angles])
-    return d
+    return model.residual(Y, Y_hat, idx)
 
 
 def predict_moments_many(model: NonlinearModel, X: np.ndarray, P: np.ndarray, u: np.ndarray | None):

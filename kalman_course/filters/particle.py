@@ -32,8 +32,7 @@ from typing import Any, Callable, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from ..core.angles import wrap_angle
-from ..core.linalg import centred_rows, covariance_factor, symmetrize, weighted_rows
+from ..core.linalg import centred_rows, covariance_factor, psd_solve, symmetrize, weighted_rows
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult
 from ..core.simulation import as_generator, check_positive_int
@@ -297,11 +296,7 @@ def _whitening(R: np.ndarray) -> Whitening:
 def _log_likelihoods(model: NonlinearModel, HX: np.ndarray, y: np.ndarray, white: Whitening, idx) -> np.ndarray:
     r""":math:`\log\mathcal N(y;\,h(x^i),\,R) = -\tfrac12\lVert L^{-1}(y - h(x^i))\rVert^2 - \tfrac m2\log 2\pi
     - \tfrac12\log|R|` pour chaque particule, (N,) ; ``white`` : :class:`Whitening` de :math:`R`."""
-    D = y - HX
-    if model.angle_indices:
-        angles = list(model.angle_indices) if idx is None else [j for j, i in enumerate(idx) if int(i) in model.angle_indices]
-        if angles:
-            D[:, angles] = wrap_angle(D[:, angles])
+    D = model.residual(y, HX, idx)
     Z = D.dot(white.Linv_t)  # lignes : L⁻¹(y − h(xⁱ)), blanchies
     with np.errstate(over="ignore", invalid="ignore"):
         maha = np.einsum("ij,ij->i", Z, Z)
@@ -385,10 +380,8 @@ def particle_family(
         y_hat, Pyy, WDy = _weighted_moments(HX, w_prev)
         S = Pyy + R
         Pxy = D.T.dot(WDy)
-        if S.shape[0] == 1:  # S scalaire : K = P_xy / S (ce que fait scipy.linalg.solve pour 1 × 1)
-            K = Pxy / S
-        else:
-            K = scipy.linalg.solve(S, Pxy.T, assume_a="pos", check_finite=False).T
+        K = psd_solve(S, Pxy.T, message=f"Filtre particulaire, correction par y[{state.k}] : la covariance "
+                                         "d'innovation équivalente P_yy + R n'est pas définie positive.").T
         nu = model.residual(y, y_hat, idx)
         state = ParticleState(X, new_logw, w, ess, increment, state.resampled, state.k, state.LQ, state.white,
                               _cloud_moments(X, w))

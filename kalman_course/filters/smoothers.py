@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from ..core.linalg import symmetrize
+from ..core.linalg import correct_square_root, covariance_root, symmetrize, triangular_root
 from ..core.models import LinearGaussianModel, NonlinearModel
 from ..core.results import FilterResult, FilterRuns, freeze
 from ..core.validation import KalmanInputError, as_controls, as_gaussian, check_instance, number_text
@@ -51,7 +51,7 @@ from .diffuse import DiffuseFilterResult, is_determined
 from .extended import NONLINEAR_HINT
 
 __all__ = ["SmootherResult", "rts_smoother", "extended_rts_smoother", "unscented_rts_smoother", "smoother_gains",
-           "rts_pass", "diffuse_rts_pass", "CONSISTENCY_RTOL"]
+           "rts_pass", "square_root_rts_pass", "diffuse_rts_pass", "CONSISTENCY_RTOL"]
 
 #: Tolérance relative de la vérification « ce résultat vient du filtre de ce modèle ».
 CONSISTENCY_RTOL = 1e-6
@@ -163,6 +163,47 @@ def rts_pass(x: np.ndarray, P: np.ndarray, x_pred: np.ndarray, P_pred: np.ndarra
     if T > 1:
         lag[1:] = Ps[1:] @ G[:-1].swapaxes(1, 2)  # Cov(x_{k+1}, x_k | y) = P_{k+1|T} G_kᵀ
     return xs, Ps, lag
+
+
+def square_root_rts_pass(x: np.ndarray, P: np.ndarray, x_pred: np.ndarray, A: np.ndarray, U_Q: np.ndarray):
+    r"""Passe arrière de RTS **en racine carrée**, pour un filtre linéaire (:math:`A`, :math:`Q = U_Q^TU_Q`).
+
+    Le lisseur conditionne :math:`x_k` (filtré : :math:`\hat x_k`, :math:`P_k = U_k^TU_k`) par
+    :math:`x_{k+1} = Ax_k + w_k` : c'est une correction de Kalman de « mesure » :math:`x_{k+1}`, de matrice
+    :math:`A` et de bruit :math:`Q` (:func:`~kalman_course.core.linalg.correct_square_root`, une QR) ; son
+    gain est :math:`G_k = P_kA^T(P^-_{k+1})^{-1}` et sa covariance a posteriori
+    :math:`P_k - G_kP^-_{k+1}G_k^T`, de racine :math:`U^c_k`. Alors
+
+    .. math::
+
+        \hat x_{k\mid T} = \hat x_k + G_k(\hat x_{k+1\mid T} - \hat x^-_{k+1}),\qquad
+        P_{k\mid T} = (U^c_k)^TU^c_k + G_kP_{k+1\mid T}G_k^T,
+
+    racine de :math:`P_{k\mid T}` par une QR de :math:`[U^c_k;\ U_{k+1\mid T}G_k^T]` : une somme de termes
+    semi-définis positifs, sans la soustraction :math:`P_{k+1\mid T} - P^-_{k+1}` de la forme usuelle, qui
+    perd tous ses chiffres quand :math:`P_k` est énorme (a priori vague). Mêmes valeurs que
+    :func:`rts_pass` aux arrondis près.
+
+    ``x`` (T, n), ``P`` (T, n, n), ``x_pred`` (T, n) du filtre. Renvoie ``(xs, Ps, G, P_lag)`` comme
+    :func:`rts_pass` (``G[T-1] = 0``, ``P_lag[0]`` NaN). Lève :class:`KalmanInputError` si une
+    :math:`P^-_{k+1}` est singulière (bruit d'état dégénéré et covariance filtrée singulière)."""
+    T, n = x.shape
+    G = np.zeros((T, n, n))
+    U_cond = np.zeros((max(T - 1, 0), n, n))
+    if T > 1:
+        zeros = np.zeros((T - 1, n))
+        _, U_cond, G[:-1], _ = correct_square_root(zeros, covariance_root(P[:-1]), zeros, A, U_Q)
+    xs = np.empty_like(x)
+    Us = np.empty((T, n, n))
+    xs[-1], Us[-1] = x[-1], covariance_root(P[-1])
+    for k in range(T - 2, -1, -1):
+        xs[k] = x[k] + G[k].dot(xs[k + 1] - x_pred[k + 1])
+        Us[k] = triangular_root(np.concatenate((U_cond[k], Us[k + 1].dot(G[k].T))))
+    Ps = np.swapaxes(Us, 1, 2) @ Us
+    lag = np.full_like(Ps, np.nan)
+    if T > 1:
+        lag[1:] = Ps[1:] @ np.swapaxes(G[:-1], 1, 2)  # Cov(x_{k+1}, x_k | y) = P_{k+1|T} G_kᵀ
+    return xs, Ps, G, lag
 
 
 def diffuse_rts_pass(A: np.ndarray, augmented: FilterResult, J: np.ndarray, h: np.ndarray):
@@ -302,9 +343,14 @@ def _smooth_initial(x0, P0, F0, Q0, fx0, result: FilterResult, xs0, Ps0):
                 "« x0 » n'est pas l'a priori du filtre : sa prédiction ne redonne pas result.x_pred[0]. "
                 "Donnez les x0, P0 passés au filtre."
             )
-    G0 = smoother_gains(P0[None], ref[None], F0)[0]
+    try:  # en racine carrée (voir square_root_rts_pass) : sûr pour un a priori vague
+        _, U_cond, G0, _ = correct_square_root(x0, covariance_root(P0), np.zeros(len(x0)), F0, covariance_root(Q0))
+        U_init = triangular_root(np.concatenate((U_cond, covariance_root(Ps0).dot(G0.T))))
+        P_init = U_init.T.dot(U_init)
+    except KalmanInputError:  # P⁻ singulière : gain de moindres carrés, forme usuelle
+        G0 = smoother_gains(P0[None], ref[None], F0)[0]
+        P_init = symmetrize(P0 + G0.dot(Ps0 - ref).dot(G0.T))
     x_init = x0 + G0.dot(xs0 - result.x_pred[0])
-    P_init = symmetrize(P0 + G0.dot(Ps0 - ref).dot(G0.T))
     return x_init, P_init, G0, Ps0.dot(G0.T)
 
 
@@ -354,10 +400,13 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
     x_next = (x[:-1] @ A.T) if model.B is None else None
     _check_consistency(result, symmetrize(A @ P[:-1] @ A.T + model.Q), x_next, model.C, model.R,
                        "filtre de Kalman", " (rts_smoother lisse la sortie de kalman_filter)")
-    G = np.zeros_like(P)
-    if result.n_steps > 1:
-        G[:-1] = smoother_gains(P[:-1], result.P_pred[1:], A)
-    xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
+    try:  # en racine carrée : sûr pour un a priori vague
+        xs, Ps, G, lag = square_root_rts_pass(x, P, result.x_pred, A, model.noise_roots[0])
+    except KalmanInputError:  # P⁻ singulière : gains de moindres carrés (smoother_gains), forme usuelle
+        G = np.zeros_like(P)
+        if result.n_steps > 1:
+            G[:-1] = smoother_gains(P[:-1], result.P_pred[1:], A)
+        xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
     prior = _initial(n, x0, P0)
     initial = (None, None, None)
     if prior is not None:

@@ -28,6 +28,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
+from ..core.linalg import psd_solve
 from ..core.models import LinearGaussianModel, NonlinearModel
 from ..core.results import FilterResult
 from ..core.validation import (
@@ -448,7 +449,7 @@ def _diagnostics(prior: _Information, post: _Information, H: np.ndarray, Rm: np.
     if not prior.full:
         return Correction(np.full((n, m), np.nan), np.full(m, np.nan), np.full((m, m), np.nan))
     S = H.dot(prior.P).dot(H.T) + Rm
-    K = scipy.linalg.cho_solve(scipy.linalg.cho_factor(Rm, lower=True), H.dot(post.P)).T
+    K = psd_solve(Rm, H.dot(post.P), message="« R » doit être définie positive.").T
     return Correction(K, nu, S)
 
 

@@ -47,7 +47,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.angles import wrap_angle
-from ..core.linalg import symmetrize
+from ..core.linalg import psd_solve, symmetrize
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, FilterRuns
 from ..core.validation import (
@@ -73,7 +73,9 @@ __all__ = [
     "unscented_family",
 ]
 
-_posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
+#: Message d'une covariance d'innovation de l'UKF qui n'est pas définie positive.
+_S_NOT_PD = ("UKF, correction par y[{k}] : la covariance d'innovation S n'est pas définie positive (des poids W^c "
+             "négatifs peuvent la rendre indéfinie) : essayez un α plus grand ou κ ≥ 0.")
 
 
 class SigmaPoints(NamedTuple):
@@ -244,14 +246,6 @@ def _deviations(Z: np.ndarray, z: np.ndarray, angles: list[int]) -> np.ndarray:
     return d
 
 
-def _observed_angles(model: NonlinearModel, idx: np.ndarray | None) -> list[int]:
-    if not model.angle_indices:
-        return []
-    if idx is None:
-        return list(model.angle_indices)
-    return [j for j, i in enumerate(idx) if int(i) in model.angle_indices]
-
-
 def _ukf_predict(model, x, P, u, Wm, Wc, scale, k):
     X = _points(x, P, scale, f"prédiction vers y[{k}]", "a posteriori P")
     Xf = model.transition_many(X, u)
@@ -267,19 +261,13 @@ def _ukf_update(model, x_pred, P_pred, y, idx, Wm, Wc, scale, k):
     R = model.R
     if idx is not None:
         Z, R = Z[:, idx], R[np.ix_(idx, idx)]
-    angles = _observed_angles(model, idx)
+    angles = model.observed_angles(idx)
     y_hat = _weighted_mean(Z, Wm, angles)
     dZ = _deviations(Z, y_hat, angles)
     WdZ = Wc[:, None] * dZ
     S = dZ.T.dot(WdZ) + R
     Pxy = (X - x_pred).T.dot(WdZ)
-    _, Kt, info = _posv(S, Pxy.T)
-    if info != 0:
-        raise KalmanInputError(
-            f"UKF, correction par y[{k}] : la covariance d'innovation S n'est pas définie positive "
-            "(des poids W^c négatifs peuvent la rendre indéfinie) : essayez un α plus grand ou κ ≥ 0."
-        )
-    K = Kt.T
+    K = psd_solve(S, Pxy.T, message=_S_NOT_PD.format(k=k)).T
     nu = model.residual(y, y_hat, idx)
     x = x_pred + K.dot(nu)
     P = symmetrize(P_pred - K.dot(S).dot(K.T))
@@ -323,7 +311,7 @@ def _ukf_update_many(model, X_pred, P_pred, Y, idx, Wm, Wc, scale, k):
     R = model.R
     if idx is not None:
         Z, R = Z[..., idx], R[np.ix_(idx, idx)]
-    angles = _observed_angles(model, idx)
+    angles = model.observed_angles(idx)
     y_hat = Wm @ Z                                     # (N, m_k)
     if angles:
         y_hat[:, angles] = np.arctan2(Wm @ np.sin(Z[..., angles]), Wm @ np.cos(Z[..., angles]))
@@ -333,15 +321,7 @@ def _ukf_update_many(model, X_pred, P_pred, Y, idx, Wm, Wc, scale, k):
     WdZ = Wc[:, None] * dZ
     S = np.swapaxes(dZ, -1, -2) @ WdZ + R              # (N, m_k, m_k)
     Pxy = np.swapaxes(pts - X_pred[:, None, :], -1, -2) @ WdZ  # (N, n, m_k)
-    try:
-        L = np.linalg.cholesky(S)
-    except np.linalg.LinAlgError:
-        bad = next(i for i in range(N) if np.any(np.linalg.eigvalsh(S[i]) <= 0))
-        raise KalmanInputError(
-            f"UKF, tirage {bad}, correction par y[{k}] : la covariance d'innovation S n'est pas définie positive "
-            "(des poids W^c négatifs peuvent la rendre indéfinie) : essayez un α plus grand ou κ ≥ 0."
-        ) from None
-    K = np.swapaxes(np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, np.swapaxes(Pxy, -1, -2))), -1, -2)
+    K = np.swapaxes(psd_solve(S, np.swapaxes(Pxy, -1, -2), message=_S_NOT_PD.format(k=k)), -1, -2)
     nu = residuals(model, Y, y_hat, idx)
     X = X_pred + (K @ nu[..., None])[..., 0]
     P = symmetrize(P_pred - K @ S @ np.swapaxes(K, -1, -2))
