@@ -2,7 +2,9 @@
 
 Les chapitres du livre n'appellent que les noms exportés ici et les sous-modules ``scenarios``
 (exemples du cours), ``figures`` (registre des figures), ``errata`` (formules imprimées fausses, pour
-les démontrer), ``numbers`` (les nombres en français) et ``interactive`` (curseurs).
+les démontrer), ``geometry`` (SO(3), SE(3), caméra), ``numbers`` (les nombres en français),
+``interactive`` (curseurs) et ``datasets`` (données réelles). Pas d'alias : un module se nomme par son
+chemin (``kc.geometry.camera``, ``kalman_course.filters.square_root_information``).
 
 Importer le paquet ne charge que les filtres (numpy et scipy) : ``figures`` (matplotlib),
 ``scenarios``, ``interactive`` (bokeh, ipywidgets), ``numbers`` (Babel) et ``datasets`` se chargent à
@@ -10,8 +12,12 @@ leur première utilisation (``kc.figures.draw(...)`` suffit). filterpy n'est jam
 c'est la référence des tests.
 """
 
-from .lecture import errata
-# cohérence
+from .core.angles import wrap_angle
+from .core.jacobians import JacobianCheck, check_jacobian, numerical_jacobian
+from .core.models import LinearGaussianModel, NonlinearModel
+from .core.results import FilterResult, FilterRuns
+from .core.simulation import Simulation, simulate
+from .core.validation import KalmanInputError
 from .diagnostics.consistency import (
     CentringTest,
     ChiSquareTest,
@@ -27,6 +33,9 @@ from .diagnostics.consistency import (
     whitened_innovations,
     whiteness_test,
 )
+from .diagnostics.monte_carlo import ConsistencyRuns, MonteCarlo, monte_carlo, monte_carlo_consistency
+from .filters.diffuse import DiffuseFilterResult, diffuse_kalman_filter
+from .filters.ensemble import EnsembleFilterResult, ensemble_kalman_filter
 from .filters.extended import ekf_predict, ekf_update, extended_kalman_filter, extended_kalman_filter_runs
 from .filters.iterated import (
     IteratedUpdate,
@@ -35,36 +44,7 @@ from .filters.iterated import (
     iterated_extended_kalman_filter_runs,
     map_cost,
 )
-from .lecture.estimator import (
-    MeanError,
-    covariance_for_gain,
-    error_transition,
-    filter_matrices,
-    linear_estimator,
-    linear_estimator_runs,
-    mean_error_recursion,
-    measurement_initialisation,
-    spectral_radius,
-)
-from .core.angles import wrap_angle
-from .core.jacobians import JacobianCheck, check_jacobian, numerical_jacobian
 from .filters.kalman import Prediction, Update, kalman_filter, kalman_filter_runs, predict, recipe_step, update
-from .core.models import LinearGaussianModel, NonlinearModel
-from .core.results import FilterResult, FilterRuns
-from .core.simulation import Simulation, simulate
-from .diagnostics.monte_carlo import ConsistencyRuns, MonteCarlo, monte_carlo, monte_carlo_consistency
-from .tables import Table
-from .core.validation import KalmanInputError
-# --- filtres à points : UKF, filtre particulaire, EnKF (issue 9) -------------------------------
-from .filters.unscented import (
-    SigmaPoints,
-    UnscentedTransform,
-    sigma_points,
-    sigma_weights,
-    unscented_kalman_filter,
-    unscented_kalman_filter_runs,
-    unscented_transform,
-)
 from .filters.particle import (
     RESAMPLING_SCHEMES,
     ParticleFilterResult,
@@ -76,44 +56,8 @@ from .filters.particle import (
     stratified_resample,
     systematic_resample,
 )
-from .filters.ensemble import EnsembleFilterResult, ensemble_kalman_filter
-# --- fin des filtres à points ------------------------------------------------------------------
-# filtre d'information en racine carrée
-from .filters import square_root_information as srif
-from .filters.square_root_information import (
-    SquareRootInformation,
-    SrifUpdate,
-    StateEstimate,
-    extended_square_root_information_filter,
-    extended_srif_predict,
-    extended_srif_update,
-    information_to_state,
-    square_root_information_filter,
-    srif_predict,
-    srif_update,
-    state_to_information,
-)
-# EKF itéré sur SE(3)
-from .geometry import camera, lie
-from .lecture import errata_se3
-from . import se3_filter
-manifold = se3_filter  # ancien nom du module
-from .geometry.camera import PinholeCamera, camera_measurement, camera_measurement_jacobian
-from .geometry.lie import oplus, ominus, se3_adjoint, se3_exp, se3_log, se3_right_jacobian
-# lissage, vraisemblance, apprentissage de Q et R
-from . import likelihood
-from .filters.diffuse import DiffuseFilterResult, diffuse_kalman_filter
-from .filters.smoothers import SmootherResult, extended_rts_smoother, rts_smoother, unscented_rts_smoother
-from .likelihood import (
-    EMResult,
-    MaximumLikelihood,
-    expectation_maximization,
-    filter_log_likelihood,
-    log_likelihood,
-    log_likelihood_terms,
-    maximum_likelihood,
-)
-from .se3_filter import (
+from .filters.se3 import (
+    CameraPoseModel,
     SE3FilterResult,
     SE3Update,
     se3_ekf_update,
@@ -123,9 +67,58 @@ from .se3_filter import (
     se3_nees,
     se3_predict,
 )
+from .filters.smoothers import SmootherResult, extended_rts_smoother, rts_smoother, unscented_rts_smoother
+from .filters.square_root_information import (
+    SquareRootInformation,
+    SrifUpdate,
+    StateEstimate,
+    extended_square_root_information_filter,
+    extended_srif_predict,
+    extended_srif_update,
+    information_rank,
+    information_to_state,
+    noise_factor,
+    square_root_information_filter,
+    srif_predict,
+    srif_update,
+    state_to_information,
+)
+from .filters.unscented import (
+    SigmaPoints,
+    UnscentedTransform,
+    sigma_points,
+    sigma_weights,
+    unscented_kalman_filter,
+    unscented_kalman_filter_runs,
+    unscented_transform,
+)
+from .geometry.camera import PinholeCamera, camera_measurement, camera_measurement_jacobian
+from .geometry.lie import oplus, ominus, se3_adjoint, se3_exp, se3_log, se3_right_jacobian
+from .lecture import errata
+from .lecture.estimator import (
+    MeanError,
+    covariance_for_gain,
+    error_transition,
+    filter_matrices,
+    linear_estimator,
+    linear_estimator_runs,
+    mean_error_recursion,
+    measurement_initialisation,
+    spectral_radius,
+)
+from .likelihood import (
+    EMResult,
+    MaximumLikelihood,
+    expectation_maximization,
+    filter_log_likelihood,
+    log_likelihood,
+    log_likelihood_terms,
+    maximum_likelihood,
+)
+from .tables import Table
 
 __all__ = [
-    # modèles, résultat, erreurs
+    # modèles, résultats, erreurs
     "LinearGaussianModel",
     "NonlinearModel",
     "FilterResult",
@@ -179,7 +172,7 @@ __all__ = [
     "check_jacobian",
     "numerical_jacobian",
     "wrap_angle",
-    # --- filtres à points : UKF, filtre particulaire, EnKF (issue 9)
+    # filtres à points : UKF, filtre particulaire, EnKF
     "SigmaPoints",
     "UnscentedTransform",
     "sigma_points",
@@ -198,7 +191,6 @@ __all__ = [
     "particle_filter",
     "EnsembleFilterResult",
     "ensemble_kalman_filter",
-    # --- fin des filtres à points
     # filtre d'information en racine carrée
     "SquareRootInformation",
     "SrifUpdate",
@@ -207,18 +199,19 @@ __all__ = [
     "srif_update",
     "state_to_information",
     "information_to_state",
+    "noise_factor",
+    "information_rank",
     "square_root_information_filter",
     "extended_srif_predict",
     "extended_srif_update",
     "extended_square_root_information_filter",
-    "srif",
     # simulation et présentation
     "Simulation",
     "simulate",
     "MonteCarlo",
     "monte_carlo",
     "Table",
-    # EKF itéré sur SE(3)
+    # EKF itéré sur SE(3) avec une caméra
     "PinholeCamera",
     "camera_measurement",
     "camera_measurement_jacobian",
@@ -228,18 +221,15 @@ __all__ = [
     "se3_exp",
     "se3_log",
     "se3_right_jacobian",
+    "CameraPoseModel",
     "SE3FilterResult",
     "SE3Update",
+    "se3_predict",
     "se3_ekf_update",
     "se3_iekf_update",
     "se3_iterated_filter",
     "se3_map_cost",
     "se3_nees",
-    "se3_predict",
-    "camera",
-    "errata_se3",
-    "lie",
-    "manifold",
     # lissage, vraisemblance, apprentissage de Q et R
     "DiffuseFilterResult",
     "diffuse_kalman_filter",
@@ -254,14 +244,14 @@ __all__ = [
     "maximum_likelihood",
     "EMResult",
     "expectation_maximization",
-    "likelihood",
-    "datasets",
     # sous-modules
     "errata",
+    "geometry",
     "figures",
     "numbers",
     "scenarios",
     "interactive",
+    "datasets",
 ]
 
 __version__ = "0.1.0"

@@ -69,7 +69,9 @@ from .filters.diffuse import (
     masked_innovations,
 )
 from .filters.engine import run_filter
+from .filters.ensemble import EnsembleFilterResult
 from .filters.kalman import kalman_filter
+from .filters.particle import ParticleFilterResult
 from .filters.smoothers import diffuse_rts_pass, rts_smoother
 
 __all__ = [
@@ -101,8 +103,15 @@ def log_likelihood_terms(result: FilterResult) -> np.ndarray:
     Paramètres : ``result`` — :class:`~kalman_course.FilterResult`. Renvoie (T,) : 0 pour un pas sans
     mesure ; NaN pour un pas observé dont la prédiction n'est pas déterminée (début d'un départ diffus,
     SRIF parti de :math:`\mathcal R_{xx} = 0`).
+
+    Filtres de Monte-Carlo : le filtre particulaire a sa propre estimation
+    :math:`\log\hat p(y_k\mid y_{1:k-1})` (``result.log_likelihood_increments``), rendue telle quelle ;
+    l'EnKF n'en a pas, et la formule gaussienne appliquée à ses innovations n'en serait qu'un substitut :
+    refusé (:func:`filter_log_likelihood`).
     """
-    check_instance("result", result, FilterResult, "la sortie d'un filtre, par exemple kalman_filter")
+    result = _own_estimate_or_refuse(result, "log_likelihood_terms")
+    if isinstance(result, ParticleFilterResult):
+        return np.array(result.log_likelihood_increments, dtype=float)
     nu, S, obs = result.innovation, result.S, np.asarray(result.observed, dtype=bool)
     if nu.ndim != 2 or S.shape != nu.shape + nu.shape[-1:]:
         raise KalmanInputError(
@@ -135,9 +144,19 @@ def filter_log_likelihood(result: FilterResult) -> float:
     * :class:`~kalman_course.FilterResult` d'un filtre à a priori connu : :math:`\sum_k \ell_k`
       (:func:`log_likelihood_terms`) ;
     * :class:`~kalman_course.filters.diffuse.DiffuseFilterResult` : la vraisemblance diffuse exacte
-      :math:`\log L_d` (voir le module), à partir du filtre augmenté.
+      :math:`\log L_d` (voir le module), à partir du filtre augmenté ;
+    * :class:`~kalman_course.ParticleFilterResult` : l'estimation du filtre particulaire lui-même,
+      :math:`\log\hat p(y_{1:T}) = \sum_k\log\hat p(y_k\mid y_{1:k-1})` (``result.log_likelihood``) ;
+    * :class:`~kalman_course.EnsembleFilterResult` : refusé — l'EnKF n'estime pas la vraisemblance, et la
+      formule gaussienne appliquée à ses innovations (covariance d'échantillon) n'en serait qu'un substitut
+      silencieux (:class:`KalmanInputError`, qui dit quoi faire).
+
+    Tout autre filtre gaussien (KF, EKF, UKF, SRIF…) : la décomposition en erreurs de prédiction de ses
+    propres innovations et covariances :math:`S_k` (pour l'EKF, la vraisemblance de son modèle linéarisé).
     """
-    check_instance("result", result, FilterResult, "la sortie d'un filtre, par exemple kalman_filter")
+    result = _own_estimate_or_refuse(result, "filter_log_likelihood")
+    if isinstance(result, ParticleFilterResult):
+        return result.log_likelihood
     if isinstance(result, DiffuseFilterResult):
         return _diffuse_value(result.augmented, result.information[-1], result.information_vector[-1])
     terms = log_likelihood_terms(result)
@@ -148,6 +167,25 @@ def filter_log_likelihood(result: FilterResult) -> float:
             "log_likelihood(model, y) sans x0 ni P0 (vraisemblance diffuse exacte), ou log_likelihood_terms."
         )
     return float(np.sum(terms))
+
+
+def _own_estimate_or_refuse(result: Any, call: str) -> FilterResult:
+    """``result`` doit être un résultat de filtre dont la vraisemblance est définie (voir
+    :func:`filter_log_likelihood`) ; un modèle passé à sa place reçoit l'appel juste."""
+    if isinstance(result, LinearGaussianModel):
+        raise KalmanInputError(
+            f"« result » est un modèle (LinearGaussianModel) : {call} prend le résultat d'un filtre. Pour la "
+            "vraisemblance d'un modèle et de mesures, appelez log_likelihood(model, y, x0, P0)."
+        )
+    check_instance("result", result, FilterResult, "la sortie d'un filtre, par exemple kalman_filter")
+    if isinstance(result, EnsembleFilterResult):
+        raise KalmanInputError(
+            "« result » vient de l'EnKF (ensemble_kalman_filter), qui n'estime pas la vraisemblance : la formule "
+            "gaussienne appliquée à ses innovations n'en serait qu'un substitut. Pour un modèle linéaire, "
+            "calculez log_likelihood(model, y, x0, P0) ; sinon, particle_filter(...).log_likelihood (estimation "
+            "sans biais de p(y)) ; log_likelihood_terms(kalman_filter(...)) donne les termes gaussiens."
+        )
+    return result
 
 
 def _diffuse_value(augmented: FilterResult, J: np.ndarray, h: np.ndarray) -> float:
@@ -198,6 +236,12 @@ def log_likelihood(model: LinearGaussianModel, y: Any, x0: Any = None, P0: Any =
 
     Renvoie un ``float`` (nats).
     """
+    if isinstance(model, FilterResult):
+        raise KalmanInputError(
+            "« model » est un résultat de filtre (FilterResult) : log_likelihood prend le modèle d'abord, "
+            "log_likelihood(model, y, x0, P0) ; pour la vraisemblance d'un résultat déjà filtré, appelez "
+            "filter_log_likelihood(result)."
+        )
     check_instance("model", model, LinearGaussianModel, "la vraisemblance est celle d'un modèle linéaire gaussien")
     if _prior(x0, P0):
         return filter_log_likelihood(kalman_filter(model, y, x0, P0, u))

@@ -1,4 +1,4 @@
-"""Caméra à sténopé et EKF itéré sur SE(3) (kalman_course.camera, manifold, errata_se3, scénario).
+"""Caméra à sténopé et EKF itéré sur SE(3) (kalman_course.geometry.camera, filters.se3, lecture.errata_se3, scénario).
 
 Oracles (ALGORITHMS.md §8) : jacobiennes des pixels contre les différences centrées de la rétraction
 (h = 1e-6, relatif 1e-6) ; :math:`J^R = J^L\\mathrm{Ad}_T` (1e-10) ; pose convergée contre un MAP calculé ici
@@ -78,7 +78,7 @@ def test_projection_and_intrinsics():
 def test_wrong_jacobians_fail_the_check():
     T, points = _random_pose_and_points(np.random.default_rng(3))
     Pc = transform_points(T, points)
-    Jpi = kc.camera.projection_jacobian(CAM, Pc)
+    Jpi = kc.geometry.camera.projection_jacobian(CAM, Pc)
     printed_row3 = np.vstack([Jpi[i] @ errata_se3.notes_point_jacobian(Pc[i], as_printed=True) for i in range(len(Pc))])
     assert not check_camera_jacobian(T, points, CAM, "left", jacobian=printed_row3)
     notes_missing = -np.vstack([errata_se3.notes_residual_jacobian(P, CAM, restore_missing=False) for P in Pc])
@@ -207,8 +207,9 @@ def test_monte_carlo_nees_iekf_consistent_ekf_not():
 
 def test_tracking_run_converges_and_ekf_is_one_iteration():
     truth, y, U, T0, P0 = ct.camera_tracking_data(10)
-    res = kc.se3_iterated_filter(y, T0, P0, ct.TARGET_POINTS, ct.CAMERA, 1.0, u=U, Q=ct.TRACK_Q)
-    ekf = kc.se3_iterated_filter(y, T0, P0, ct.TARGET_POINTS, ct.CAMERA, 1.0, u=U, Q=ct.TRACK_Q, max_iter=1)
+    model = kc.CameraPoseModel(ct.TARGET_POINTS, ct.CAMERA, 1.0, ct.TRACK_Q)
+    res = kc.se3_iterated_filter(model, y, T0, P0, U)
+    ekf = kc.se3_iterated_filter(model, y, T0, P0, U, max_iter=1)
     assert res.T.shape == (10, 4, 4) and res.P.shape == (10, 6, 6)
     assert np.all(ekf.n_iter == 1) and np.all(res.n_iter > 1)
     rot, pos = ct.pose_error(res.T[-1], truth[-1])
@@ -261,5 +262,6 @@ def test_other_bad_inputs_are_french_errors(problem):
         kc.se3_predict(np.eye(4), np.eye(6), np.zeros(3), np.eye(6))
     with pytest.raises(kc.KalmanInputError, match="« Q » doit être semi-définie positive"):
         kc.se3_predict(np.eye(4), np.eye(6), np.zeros(6), -np.eye(6))
+    model = kc.CameraPoseModel(problem.points, problem.camera, 1.0)
     with pytest.raises(kc.KalmanInputError, match=r"« y » doit être de forme \(T, 20\)"):
-        kc.se3_iterated_filter(np.zeros(20), problem.T_pred, problem.P_pred, problem.points, problem.camera, 1.0)
+        kc.se3_iterated_filter(model, np.zeros(20), problem.T_pred, problem.P_pred)

@@ -297,7 +297,7 @@ def test_ukf_bad_inputs_are_french_errors():
         kc.unscented_kalman_filter(model, data.y, data.x0, data.P0, alpha=1.0, kappa=-2.0)
     with pytest.raises(kc.KalmanInputError, match="« beta » doit être un nombre réel fini"):
         kc.unscented_kalman_filter(model, data.y, data.x0, data.P0, alpha=1.0, beta=np.nan, kappa=0.0)
-    with pytest.raises(TypeError):  # alpha et kappa n'ont pas de valeur par défaut
+    with pytest.raises(kc.KalmanInputError, match="« alpha » est obligatoire"):  # ni α ni κ par défaut : erreur française
         kc.unscented_kalman_filter(model, data.y, data.x0, data.P0)
     with pytest.raises(kc.KalmanInputError, match="« P0 » doit être définie positive"):
         kc.unscented_kalman_filter(model, data.y, data.x0, np.diag([1.0, 0.0]), alpha=1.0, kappa=0.0)

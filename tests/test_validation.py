@@ -240,7 +240,7 @@ def test_se3_filter_with_zero_prior_and_noise_runs_instead_of_blaming_P_pred():
     from kalman_course.scenarios import camera_target as ct
 
     truth, y, U, T0, P0 = ct.camera_tracking_data(3)
-    res = kc.se3_iterated_filter(y, T0, np.zeros((6, 6)), ct.TARGET_POINTS, ct.CAMERA, 1.0, u=U)
+    res = kc.se3_iterated_filter(kc.CameraPoseModel(ct.TARGET_POINTS, ct.CAMERA, 1.0), y, T0, np.zeros((6, 6)), U)
     np.testing.assert_allclose(res.P, 0.0, atol=1e-12)  # aucune incertitude : les mesures ne corrigent rien
     np.testing.assert_allclose(res.T[-1], T0 @ kc.se3_exp(U[0]) @ kc.se3_exp(U[1]) @ kc.se3_exp(U[2]), atol=1e-12)
 
@@ -258,8 +258,8 @@ def _camera_behind():
         (lambda: model2(Q=[[0.01, 0.0], [0.25, 0.01]]), "0,25"),
         (lambda: kc.unscented_kalman_filter(kc.NonlinearModel.from_linear(model2()), np.zeros(3), np.zeros(2),
                                             [[1.0, 0.0], [0.0, -0.5]], alpha=1.0, kappa=0.0), "−0,5"),
-        (lambda: kc.lie.as_rotation("R", np.diag([1.0, 1.0, 1.5])), "det R = 1,5"),
-        (lambda: kc.lie.as_pose("T", np.vstack([np.eye(4)[:3], [0.125, 0.0, 0.0, 1.0]])), "[0,1250  0,0000"),
+        (lambda: kc.geometry.lie.as_rotation("R", np.diag([1.0, 1.0, 1.5])), "det R = 1,5"),
+        (lambda: kc.geometry.lie.as_pose("T", np.vstack([np.eye(4)[:3], [0.125, 0.0, 0.0, 1.0]])), "[0,1250  0,0000"),
         (lambda: kc.square_root_information_filter(model2(), np.zeros(3), None, None, R0=[[1.0, 0.0], [0.5, 1.0]],
                                                       z0=np.zeros(2)),
          "0,5"),
@@ -306,3 +306,79 @@ def test_the_core_does_not_import_babel():
             "except kc.KalmanInputError as e:\n    assert '−1' in str(e), str(e)\n"
             "assert 'babel' not in sys.modules and 'kalman_course.numbers' not in sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+# --------------------------------------------------------------------------- erreurs d'usage : l'appel juste
+
+
+def _misuse_setup():
+    from kalman_course.scenarios import nile as sn
+
+    model = sn.local_level_model(15099.0, 1469.1)
+    y = kc.datasets.nile().flow
+    return model, y, kc.kalman_filter(model, y, [1000.0], [[1e7]])
+
+
+MISUSES = [
+    ("log_likelihood(result, y)", lambda m, y, r: kc.log_likelihood(r, y),
+     r"« model » est un résultat de filtre \(FilterResult\) : log_likelihood prend le modèle d'abord, "
+     r"log_likelihood\(model, y, x0, P0\) ; .* appelez filter_log_likelihood\(result\)"),
+    ("filter_log_likelihood(model)", lambda m, y, r: kc.filter_log_likelihood(m),
+     r"« result » est un modèle .* appelez log_likelihood\(model, y, x0, P0\)"),
+    ("rts_smoother(result, model)", lambda m, y, r: kc.rts_smoother(r, m),
+     r"« model » est un résultat de filtre \(FilterResult\) : les arguments sont inversés ; appelez "
+     r"rts_smoother\(model, result\)"),
+    ("extended_rts_smoother(result, model)", lambda m, y, r: kc.extended_rts_smoother(r, kc.NonlinearModel.from_linear(m)),
+     r"les arguments sont inversés ; appelez extended_rts_smoother\(model, result\)"),
+    ("unscented_rts_smoother(result, model)", lambda m, y, r: kc.unscented_rts_smoother(
+        r, kc.NonlinearModel.from_linear(m), alpha=1.0, kappa=0.0),
+     r"les arguments sont inversés ; appelez unscented_rts_smoother\(model, result\)"),
+    ("nis(diffuse_result)", lambda m, y, r: kc.nis(kc.diffuse_kalman_filter(m, y)),
+     r"« result » vient de diffuse_kalman_filter : au début \(1 pas ici\), l'état n'est pas encore déterminé .* "
+     r"nis\(result\.after_diffuse\(\)\)"),
+    ("nis_test(diffuse_result)", lambda m, y, r: kc.nis_test(kc.diffuse_kalman_filter(m, y)),
+     r"vient de diffuse_kalman_filter .* result\.after_diffuse\(\)"),
+    ("whiteness_test(diffuse_result)", lambda m, y, r: kc.whiteness_test(kc.diffuse_kalman_filter(m, y)),
+     r"vient de diffuse_kalman_filter .*result\.after_diffuse\(\)"),
+    ("kalman_filter_runs(model, y 2-D)", lambda m, y, r: kc.kalman_filter_runs(m, y[:, None], [0.0], [[1.0]]),
+     r"« Y » doit être de forme \(N, T, 1\) .* reçu la forme \(100, 1\) : pour un seul tirage, filtrez-le sans "
+     r"« _runs » ou donnez Y\[None\]"),
+    ("kalman_filter(form=…)", lambda m, y, r: kc.kalman_filter(m, y, [0.0], [[1.0]], form="joseph form"),
+     r"« form » doit être l'une des formes 'square_root', 'textbook', 'joseph' ; reçu 'joseph form'"),
+    ("unscented_kalman_filter sans alpha", lambda m, y, r: kc.unscented_kalman_filter(
+        kc.NonlinearModel.from_linear(m), y, [1000.0], [[1e7]], kappa=0.0), r"« alpha » est obligatoire .* alpha=1\.0, kappa=0\.0"),
+    ("unscented_kalman_filter sans kappa", lambda m, y, r: kc.unscented_kalman_filter(
+        kc.NonlinearModel.from_linear(m), y, [1000.0], [[1e7]], alpha=1.0), r"« kappa » est obligatoire"),
+    ("unscented_rts_smoother sans kappa (comme le filtre)", lambda m, y, r: kc.unscented_rts_smoother(
+        kc.NonlinearModel.from_linear(m), kc.unscented_kalman_filter(kc.NonlinearModel.from_linear(m), y, [1000.0],
+                                                                      [[1e7]], alpha=1.0, kappa=0.0), alpha=1.0),
+     r"« kappa » est obligatoire"),
+    ("se3_iterated_filter(y, T0, P0, u)", lambda m, y, r: kc.se3_iterated_filter(np.zeros((3, 8)), np.eye(4), np.eye(6), None),
+     r"« model » doit être un CameraPoseModel ; reçu ndarray : le modèle vient d'abord"),
+]
+
+
+@pytest.mark.parametrize("name, call, message", MISUSES, ids=[m[0] for m in MISUSES])
+def test_misuse_gets_a_french_error_with_the_right_call(name, call, message):
+    model, y, result = _misuse_setup()
+    with pytest.raises(KalmanInputError, match=message):
+        call(model, y, result)
+
+
+def test_likelihood_of_monte_carlo_filters_is_their_own_estimate_or_refused():
+    """Filtre particulaire : sa propre estimation log p̂(y) (somme des incréments), pas la formule gaussienne
+    appliquée à ses innovations ; EnKF : refusé en français (il n'estime pas la vraisemblance)."""
+    from kalman_course.scenarios import convergence
+
+    bench = convergence.linear_benchmark(n_steps=20)
+    pf = kc.particle_filter(bench.nonlinear, bench.y, bench.x0, bench.P0, n_particles=300, rng=0)
+    assert kc.filter_log_likelihood(pf) == pytest.approx(float(np.sum(pf.log_likelihood_increments)), abs=1e-12)
+    np.testing.assert_array_equal(kc.log_likelihood_terms(pf), pf.log_likelihood_increments)
+    gaussian = float(np.sum(kc.likelihood.log_likelihood_terms(kc.FilterResult(
+        x=pf.x, P=pf.P, x_pred=pf.x_pred, P_pred=pf.P_pred, K=pf.K, innovation=pf.innovation, S=pf.S,
+        observed=pf.observed, n_iter=pf.n_iter))))
+    assert kc.filter_log_likelihood(pf) != pytest.approx(gaussian, abs=1e-6)  # pas le substitut gaussien
+    enkf = kc.ensemble_kalman_filter(bench.nonlinear, bench.y, bench.x0, bench.P0, n_members=200, rng=0)
+    for call in (kc.filter_log_likelihood, kc.log_likelihood_terms):
+        with pytest.raises(KalmanInputError, match=r"« result » vient de l'EnKF .* n'estime pas la vraisemblance"):
+            call(enkf)

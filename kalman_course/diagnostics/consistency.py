@@ -28,6 +28,7 @@ import scipy.linalg
 import scipy.stats
 
 from ..core.linalg import psd_solve
+from ..filters.diffuse import DiffuseFilterResult
 from ..core.results import FilterResult, FilterRuns, freeze_fields
 from ..core.simulation import check_positive_int
 from ..tables import Table
@@ -66,6 +67,12 @@ def _check_result(result: Any, name: str = "result") -> FilterResult:
         raise KalmanInputError(
             f"« {name} » doit être le résultat d'un seul tirage ; reçu un FilterRuns de {result.n_runs} tirages "
             f"(prendre « {name}.run(i) », ou voir monte_carlo_consistency)."
+        )
+    if isinstance(result, DiffuseFilterResult):
+        raise KalmanInputError(
+            f"« {name} » vient de diffuse_kalman_filter : au début ({result.n_diffuse} pas ici), l'état n'est pas "
+            "encore déterminé par les mesures et ni l'innovation ni sa covariance n'y sont définies. Testez les "
+            f"pas suivants : passez {name}.after_diffuse(), par exemple nis({name}.after_diffuse())."
         )
     return result
 

@@ -217,7 +217,7 @@ def ekf_predict(model: NonlinearModel, x: Any, P: Any, u: Any = None) -> Predict
     return Prediction(*predict_moments(model, x_arr, P_arr, check_control(model, u)))
 
 
-def ekf_update(model: NonlinearModel, x_pred: Any, P_pred: Any, y: Any, joseph: bool = False) -> Update:
+def ekf_update(model: NonlinearModel, x_pred: Any, P_pred: Any, y: Any, *, joseph: bool = False) -> Update:
     r"""Correction de l'EKF : la correction linéaire avec la jacobienne :math:`H_k` à la place de :math:`C`.
 
     .. math::
@@ -242,7 +242,7 @@ def ekf_update(model: NonlinearModel, x_pred: Any, P_pred: Any, y: Any, joseph: 
 
 
 def extended_kalman_filter(
-    model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = None, joseph: bool = False
+    model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = None, *, joseph: bool = False
 ) -> FilterResult:
     r"""Filtre de Kalman étendu sur toutes les mesures (pour chaque ``y[k]`` : :func:`ekf_predict` puis
     :func:`ekf_update`), dans l'ordre de :func:`~kalman_course.kalman_filter`.
@@ -262,7 +262,7 @@ def extended_kalman_filter(
 
 
 def extended_kalman_filter_runs(
-    model: NonlinearModel, Y: Any, x0: Any, P0: Any, u: Any = None, joseph: bool = False
+    model: NonlinearModel, Y: Any, x0: Any, P0: Any, u: Any = None, *, joseph: bool = False
 ) -> FilterRuns:
     r"""Filtre de Kalman étendu sur ``N`` tirages indépendants du même modèle, tous à la fois
     (:func:`~kalman_course.filters.engine.run_filter_runs`) : mêmes équations que

@@ -245,6 +245,15 @@ def diffuse_rts_pass(A: np.ndarray, augmented: FilterResult, J: np.ndarray, h: n
 # --------------------------------------------------------------------------- vérifications
 
 
+def _check_order(model: Any, result: Any, call: str) -> None:
+    """Les arguments inversés (``rts_smoother(result, model)``) : une erreur qui donne l'appel juste."""
+    if isinstance(model, FilterResult):
+        raise KalmanInputError(
+            f"« model » est un résultat de filtre ({type(model).__name__}) : les arguments sont inversés ; "
+            f"appelez {call}(model, result), le modèle d'abord."
+        )
+
+
 def _check_result(result: Any) -> FilterResult:
     if isinstance(result, FilterRuns):
         raise KalmanInputError(
@@ -384,6 +393,7 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
 
     Renvoie un :class:`SmootherResult` (``x`` (T, n), ``P`` (T, n, n), ``G``, ``P_lag``).
     """
+    _check_order(model, result, "rts_smoother")
     check_instance("model", model, LinearGaussianModel, "pour un modèle non linéaire, utilisez extended_rts_smoother")
     result = _check_result(result)
     n, m = model.n_state, model.n_obs
@@ -473,6 +483,7 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
     u : (T, p), ou (T,) si p = 1, optionnel — les commandes données au filtre (nécessaires : elles
         entrent dans :math:`F_k`).
     """
+    _check_order(model, result, "extended_rts_smoother")
     model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
     result = _check_result(result)
     if isinstance(result, DiffuseFilterResult):
@@ -520,8 +531,8 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
     return SmootherResult(xs, Ps, G, lag, *initial, method="RTS étendu")
 
 
-def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha: float, beta: float = 2.0,
-                           kappa: float = 0.0, u: Any = None) -> SmootherResult:
+def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha: float | None = None,
+                           beta: float = 2.0, kappa: float | None = None, u: Any = None) -> SmootherResult:
     r"""Lisseur RTS « sans parfum » (Särkkä, 2008) pour un résultat de
     :func:`~kalman_course.unscented_kalman_filter`, avec les mêmes paramètres :math:`(\alpha, \beta, \kappa)`.
 
@@ -541,10 +552,13 @@ def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha
     :math:`(\bar x, \bar P)` est la prédiction de l'UKF : on vérifie qu'elle redonne celle du résultat
     (même modèle, même filtre, mêmes paramètres). Sur un modèle linéaire avec :math:`\alpha = 1`,
     :math:`\beta = 2`, :math:`\kappa = 0`, c'est :func:`rts_smoother`. ``G`` (T, n, n), ``P_lag`` comme
-    :func:`rts_smoother`. Paramètres : ``u`` (T, p) : les commandes données au filtre.
+    :func:`rts_smoother`. Paramètres : ``alpha``, ``beta``, ``kappa`` : ceux du filtre, avec les mêmes règles
+    (``alpha`` et ``kappa`` obligatoires, ``beta = 2`` par défaut) ; ``u`` (T, p) : les commandes données au
+    filtre.
     """
     from .unscented import _points, sigma_weights
 
+    _check_order(model, result, "unscented_rts_smoother")
     model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
     result = _check_result(result)
     n, m, T = model.n_state, model.n_obs, result.n_steps

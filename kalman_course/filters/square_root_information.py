@@ -335,7 +335,7 @@ def information_to_state(R: Any, z: Any) -> StateEstimate:
 # --------------------------------------------------------------------------- étapes publiques
 
 
-def srif_predict(model: LinearGaussianModel, R: Any, z: Any, u: Any = None,
+def srif_predict(model: LinearGaussianModel, R: Any, z: Any, u: Any = None, *,
                  method: str = "inverse") -> SquareRootInformation:
     r"""Prédiction (*time update*) du SRIF : :math:`(\hat{\mathcal R}_{xx}(k), \hat z_x(k)) \to
     (\bar{\mathcal R}_{xx}(k+1), \bar z_x(k+1))`.
@@ -463,6 +463,7 @@ def square_root_information_filter(
     x0: Any = None,
     P0: Any = None,
     u: Any = None,
+    *,
     R0: Any = None,
     z0: Any = None,
     method: str = "inverse",

@@ -108,6 +108,13 @@ class UnscentedTransform(NamedTuple):
 
 
 def _check_parameters(n: int, alpha: Any, beta: Any, kappa: Any) -> tuple[float, float, float]:
+    for name, value in (("alpha", alpha), ("kappa", kappa)):
+        if value is None:  # le filtre et son lisseur n'ont pas de valeur par défaut pour α et κ
+            raise KalmanInputError(
+                f"« {name} » est obligatoire : le bon écartement des points sigma dépend du problème (chapitre UKF). "
+                "Donnez alpha et kappa, par exemple alpha=1.0, kappa=0.0 (le filtre de Kalman sur un modèle "
+                "linéaire), ou alpha=0.1, kappa=3 − n."
+            )
     values = []
     for name, value in (("alpha", alpha), ("beta", beta), ("kappa", kappa)):
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
@@ -401,9 +408,9 @@ def unscented_kalman_filter(
     P0: Any,
     u: Any = None,
     *,
-    alpha: float,
+    alpha: float | None = None,
     beta: float = 2.0,
-    kappa: float,
+    kappa: float | None = None,
 ) -> FilterResult:
     r"""Filtre de Kalman sans parfum sur toutes les mesures (pour chaque ``y[k]`` : prédiction puis
     correction, dans l'ordre de :func:`~kalman_course.kalman_filter`).
@@ -435,9 +442,9 @@ def unscented_kalman_filter_runs(
     P0: Any,
     u: Any = None,
     *,
-    alpha: float,
+    alpha: float | None = None,
     beta: float = 2.0,
-    kappa: float,
+    kappa: float | None = None,
 ) -> FilterRuns:
     r"""Filtre de Kalman sans parfum sur ``N`` tirages indépendants du même modèle, tous à la fois
     (:func:`~kalman_course.filters.engine.run_filter_runs`) : les formules de :func:`unscented_kalman_filter`

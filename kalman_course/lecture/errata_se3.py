@@ -1,6 +1,6 @@
 r"""Les formules des notes « IEKF sur SE(3) » **telles qu'écrites** (fausses), pour montrer les errata 004-*.
 
-Ne pas utiliser pour filtrer : la forme correcte est :func:`kalman_course.se3_filter.se3_iekf_update`.
+Ne pas utiliser pour filtrer : la forme correcte est :func:`kalman_course.filters.se3.se3_iekf_update`.
 
 * :func:`notes_residual` — erratum 004-2 : :math:`e = [u - f_xX'/Z' + c_x;\ v - f_yY'/Z' + c_y]` (signe de
   :math:`c_x, c_y`).
@@ -27,7 +27,7 @@ from ..geometry.camera import PinholeCamera, _check_camera, _measure, _measureme
 from ..core.linalg import kalman_gain
 from ..filters.iteration import DEFAULT_MAX_ITER, DEFAULT_TOL, iterate
 from ..geometry.lie import _se3_exp, _se3_inverse, _se3_jl_inv, _se3_log, as_pose
-from ..se3_filter import _check_update_inputs
+from ..filters.se3 import _check_update_inputs
 from ..core.validation import KalmanInputError
 
 __all__ = [

@@ -21,7 +21,7 @@ import scipy.optimize
 
 from ..geometry.camera import PinholeCamera, camera_measurement
 from ..geometry.lie import se3_exp, se3_inverse, se3_log
-from ..se3_filter import SE3FilterResult, se3_iekf_update, se3_iterated_filter, se3_map_cost, se3_nees
+from ..filters.se3 import CameraPoseModel, SE3FilterResult, se3_iekf_update, se3_iterated_filter, se3_map_cost, se3_nees
 from ..core.results import freeze, freeze_fields
 from ..core.simulation import as_generator
 from ..tables import Table
@@ -93,9 +93,9 @@ class CameraTargetProblem:
         freeze_fields(self, "T_pred", "P_pred", "y", "T_true", "points")
 
     def iekf(self, max_iter: int = 20, tol: float = 1e-10, **kwargs):
-        """:func:`~kalman_course.manifold.se3_iekf_update` sur ce problème."""
+        """:func:`~kalman_course.filters.se3.se3_iekf_update` sur ce problème."""
         return se3_iekf_update(self.T_pred, self.P_pred, self.y, self.points, self.camera, self.sigma_px,
-                               max_iter, tol, **kwargs)
+                               max_iter=max_iter, tol=tol, **kwargs)
 
     def cost(self, T: Any) -> float:
         """Coût MAP :math:`J(T)`."""
@@ -257,4 +257,5 @@ def camera_tracking_data(n_frames: int = 30, rng: Any = 5):
 def camera_tracking_run(n_frames: int = 30, rng: Any = 5, max_iter: int = 20) -> tuple[np.ndarray, SE3FilterResult]:
     """Données de :func:`camera_tracking_data` filtrées ; renvoie ``(T_true, résultat)``."""
     truth, y, U, T0, P0 = camera_tracking_data(n_frames, rng)
-    return truth, se3_iterated_filter(y, T0, P0, TARGET_POINTS, CAMERA, SIGMA_PX, u=U, Q=TRACK_Q, max_iter=max_iter)
+    model = CameraPoseModel(TARGET_POINTS, CAMERA, SIGMA_PX, TRACK_Q)
+    return truth, se3_iterated_filter(model, y, T0, P0, U, max_iter=max_iter)

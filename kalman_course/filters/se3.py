@@ -24,20 +24,15 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from .core.linalg import cholesky_factor, symmetrize
-from .core.results import FilterResult
-from .filters.engine import Correction, FilterFamily, run_filter
-from .filters.iteration import DEFAULT_MAX_ITER, DEFAULT_TOL, StateSpace, check_iterations, gauss_newton_update
-from .geometry.camera import PinholeCamera, _check_camera, _measure, _measurement_jacobian, as_points
-from .geometry.lie import (
-    _se3_adjoint,
-    _se3_exp,
-    _se3_inverse,
-    _se3_jl,
-    _se3_log,
-    as_pose,
+from ..core.linalg import cholesky_factor, symmetrize
+from ..core.results import FilterResult
+from ..core.validation import (
+    KalmanInputError, as_float_array, as_square_matrix, as_vector, check_pd, check_psd, shape_text,
 )
-from .core.validation import KalmanInputError, as_float_array, as_square_matrix, as_vector, check_pd, check_psd, shape_text
+from ..geometry.camera import PinholeCamera, _check_camera, _measure, _measurement_jacobian, as_points
+from ..geometry.lie import _se3_adjoint, _se3_exp, _se3_inverse, _se3_jl, _se3_log, as_pose
+from .engine import Correction, FilterFamily, run_filter
+from .iteration import DEFAULT_MAX_ITER, DEFAULT_TOL, StateSpace, check_iterations, gauss_newton_update
 
 __all__ = [
     "CameraPoseModel",
@@ -138,7 +133,8 @@ class CameraPoseModel:
     (pixels des ``N`` points connus ``points`` (N, 3) vus par ``camera``).
 
     ``sigma_px`` : écart-type du bruit de pixel (px) ; ``Q`` (6, 6) : covariance du bruit d'incrément
-    (``None`` : nulle). ``n_obs`` = 2N, ``n_control`` = 6 (incréments :math:`u_k = [\rho;\theta]`)."""
+    (``None`` : nulle). ``n_obs`` = 2N, ``n_control`` = 6 (incréments :math:`u_k = [\rho;\theta]`). C'est le
+    premier argument de :func:`se3_iterated_filter`, comme le modèle de tous les filtres du paquet."""
 
     points: np.ndarray
     camera: PinholeCamera
@@ -267,9 +263,9 @@ def se3_iekf_update(
     points: Any,
     camera: PinholeCamera,
     sigma_px: float,
+    *,
     max_iter: int = DEFAULT_MAX_ITER,
     tol: float = DEFAULT_TOL,
-    *,
     use_right_jacobian: bool = True,
 ) -> SE3Update:
     r"""Correction itérée sur SE(3) (Gauss–Newton sur le coût MAP, perturbation à droite).
@@ -292,7 +288,7 @@ def se3_iekf_update(
 
     Paramètres : ``T_pred`` (4, 4), ``P_pred`` (6, 6) définie positive, ``y`` (2n,) pixels
     :math:`[u_1, v_1, \dots]`, ``points`` (n, 3) points connus de la cible (m), ``camera``
-    (:class:`~kalman_course.camera.PinholeCamera`), ``sigma_px`` (px).
+    (:class:`~kalman_course.geometry.camera.PinholeCamera`), ``sigma_px`` (px).
     Renvoie :class:`SE3Update` (pose, covariance, nombre d'itérations et historique).
     """
     max_iter, tol = check_iterations(max_iter, tol)
@@ -323,24 +319,29 @@ def se3_nees(T_est: Any, P: Any, T_true: Any) -> float:
 
 
 def se3_iterated_filter(
+    model: CameraPoseModel,
     y: Any,
     T0: Any,
     P0: Any,
-    points: Any,
-    camera: PinholeCamera,
-    sigma_px: float,
     u: Any = None,
-    Q: Any = None,
+    *,
     max_iter: int = DEFAULT_MAX_ITER,
     tol: float = DEFAULT_TOL,
 ) -> SE3FilterResult:
     r"""Suivi sur ``F`` images : pour chaque image ``k``, :func:`se3_predict` avec ``u[k]`` puis
-    :func:`se3_iekf_update` avec ``y[k]`` (``max_iter=1`` : EKF sur la variété).
+    :func:`se3_iekf_update` avec ``y[k]`` (``max_iter=1`` : EKF sur la variété), par le moteur commun.
 
-    Paramètres : ``y`` (F, 2n) pixels ; ``T0`` (4, 4), ``P0`` (6, 6) : estimation avant la première image ;
-    ``u`` (F, 6) incréments connus (``None`` : nuls) ; ``Q`` (6, 6) bruit d'incrément (``None`` : nul).
+    Paramètres : ``model`` (:class:`CameraPoseModel` : points de la cible, caméra, bruit de pixel, bruit
+    d'incrément :math:`Q`) ; ``y`` (F, 2n) pixels ; ``T0`` (4, 4), ``P0`` (6, 6) : estimation avant la
+    première image ; ``u`` (F, 6) incréments connus (``None`` : nuls) ; ``max_iter``, ``tol`` : arrêt de
+    Gauss–Newton à chaque image.
     """
-    model = CameraPoseModel(points, camera, sigma_px, Q)
+    if not isinstance(model, CameraPoseModel):
+        hint = ""
+        if np.ndim(model) == 2:  # l'ancien ordre : les pixels d'abord
+            hint = (" : le modèle vient d'abord, se3_iterated_filter(CameraPoseModel(points, camera, sigma_px, Q), "
+                    "y, T0, P0, u)")
+        raise KalmanInputError(f"« model » doit être un CameraPoseModel ; reçu {type(model).__name__}{hint}.")
     return run_filter(se3_family(max_iter, tol), model, y, T0, P0, u)
 
 
