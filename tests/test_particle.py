@@ -156,15 +156,15 @@ def test_likelihood_estimate_is_unbiased_and_its_log_is_biased_down():
 
 
 def test_same_seed_same_output_and_generator_accepted():
+    """Une graine entière et un Generator de même graine : deux exécutions, les mêmes tirages ; une autre
+    graine : d'autres tirages."""
     data = pendulum.pendulum_data(60)
     model = pendulum.pendulum_model()
     a = kc.particle_filter(model, data.y, data.x0, data.P0, n_particles=500, rng=3, resampling="stratified")
-    b = kc.particle_filter(model, data.y, data.x0, data.P0, n_particles=500, rng=3, resampling="stratified")
     c = kc.particle_filter(model, data.y, data.x0, data.P0, n_particles=500, rng=np.random.default_rng(3),
                            resampling="stratified")
     d = kc.particle_filter(model, data.y, data.x0, data.P0, n_particles=500, rng=4, resampling="stratified")
     for field in ("x", "P", "ess", "log_likelihood_increments"):
-        np.testing.assert_array_equal(getattr(a, field), getattr(b, field))
         np.testing.assert_array_equal(getattr(a, field), getattr(c, field))
     assert not np.array_equal(a.x, d.x)
     assert isinstance(a, kc.FilterResult) and a.x.shape == (60, 2) and a.ess.shape == (60,)
