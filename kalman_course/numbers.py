@@ -309,11 +309,11 @@ def french_figure(figure) -> None:
     :func:`matplotlib_formatter`, des axes logarithmiques (notation scientifique de matplotlib) par
     :func:`matplotlib_log_formatter` (les autres formateurs choisis par la figure sont laissés) et
     typographie des textes — titres, légendes, libellés, annotations — par
-    :func:`kalman_course.book_typography.french_spacing` (espaces insécables, apostrophe « ’ »,
+    :func:`kalman_course.typography.french_spacing` (espaces insécables, apostrophe « ’ »,
     formules ``$…$`` intactes)."""
     from matplotlib.ticker import LogFormatterSciNotation, ScalarFormatter
 
-    from .book_typography import french_spacing
+    from .typography import french_spacing
 
     for ax in figure.get_axes():
         for axis in (ax.xaxis, ax.yaxis, getattr(ax, "zaxis", None)):

@@ -2,7 +2,8 @@
 # Construit le site dans _build/html (installe d'abord ce qu'il faut : voir scripts/setup.sh).
 # Avec --pdf : construit aussi le cours en un seul PDF, _build/pdf/filtre-de-kalman.pdf (LaTeX de
 # Jupyter Book, XeLaTeX, césure française) ; setup.sh installe alors TeX Live (paquets Debian).
-# Toutes les pages sont réécrites (--all) ; les carnets inchangés viennent du cache d'exécution.
+# Toutes les pages sont réécrites (--all) ; les carnets inchangés viennent du cache d'exécution, les
+# autres sont d'abord exécutés en parallèle (scripts/execute_notebooks.py).
 # La construction échoue sur toute erreur de cellule et tout avertissement Sphinx (-W).
 # Les autres arguments sont transmis à « jupyter-book build ».
 set -euo pipefail
@@ -22,6 +23,9 @@ if [ "$(cat _build/.kalman_course.sha 2>/dev/null)" != "$pkg_sha" ]; then
   rm -rf _build/.jupyter_cache
   mkdir -p _build && echo "$pkg_sha" > _build/.kalman_course.sha
 fi
+# Les carnets absents du cache, exécutés en parallèle (un noyau par cœur) et rangés dans le cache :
+# la construction les y trouve et n'en exécute aucun (voir scripts/execute_notebooks.py).
+.venv/bin/python scripts/execute_notebooks.py _build/.jupyter_cache
 .venv/bin/jupyter-book build . --all -W --keep-going ${args[@]+"${args[@]}"}
 echo "Site construit : $(pwd)/_build/html/index.html"
 

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Prépare tout ce dont la construction et les tests ont besoin, sans rien supposer de la machine :
-#   - .venv/ : Python 3.11 ou 3.12 avec requirements.txt (versions figées) et le paquet kalman_course (éditable) ;
+#   - .venv/ : Python 3.11, 3.12 ou 3.13 avec requirements.txt (versions figées) et le paquet kalman_course (éditable) ;
 #   - node_modules/ : MathJax et mermaid-cli (package-lock.json), sans téléchargement de navigateur ;
 #   - book/vendor/ : les ressources web copiées pour être servies par le site lui-même (hors ligne) ;
 #   - Chromium (paquet Debian) : rendu des diagrammes Mermaid à la construction et tests navigateur ;
 #   - avec --pdf seulement : TeX Live (XeLaTeX, français, latexmk), polices et pdftotext (paquets Debian),
 #     pour le livre en PDF.
 # Interpréteur : la variable PYTHON s'il est donné (ex. PYTHON=/usr/bin/python3), sinon le premier
-# Python pris en charge parmi python3, python3.12, python3.11, /usr/bin/python3.
+# Python pris en charge parmi python3, python3.13, python3.12, python3.11, /usr/bin/python3.
 # Idempotent : une seconde exécution ne refait que ce qui a changé.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,9 +23,9 @@ for arg in "$@"; do
 done
 
 # Pythons pris en charge : ceux sur lesquels requirements.txt s'installe et les tests passent.
-SUPPORTED_TEXT="3.11 (dès 3.11.2, celui de Debian 12) et 3.12 (celui d'Ubuntu 24.04)"
+SUPPORTED_TEXT="3.11 (dès 3.11.2, celui de Debian 12), 3.12 (celui d'Ubuntu 24.04) et 3.13 (celui de Debian 13)"
 python_version() { "$1" -c 'import sys; print("%d.%d.%d" % sys.version_info[:3])' 2>/dev/null; }
-is_supported() { case "$1" in 3.11.0|3.11.1) return 1 ;; 3.11.*|3.12.*) return 0 ;; *) return 1 ;; esac; }
+is_supported() { case "$1" in 3.11.0|3.11.1) return 1 ;; 3.11.*|3.12.*|3.13.*) return 0 ;; *) return 1 ;; esac; }
 
 apt_install() {
   # apt_install RAISON PAQUET… : installe des paquets Debian si l'on est root, sinon explique quoi faire.
@@ -63,6 +63,31 @@ if [ "$want_pdf" = 1 ] && ! tex_ready; then
   tex_ready || { log "ERREUR : TeX Live installé mais incomplet (xelatex, latexmk, polyglossia, césure fr)"; exit 1; }
 fi
 
+# --- npm, en arrière-plan (pendant l'installation des dépendances Python) -------------------------
+stamp_npm=node_modules/.lock.sha
+want_npm=$(sha256sum package-lock.json | cut -d' ' -f1)
+npm_pid=""
+npm_log=""
+if [ ! -f "$stamp_npm" ] || [ "$(cat "$stamp_npm")" != "$want_npm" ]; then
+  log "installation des ressources npm (npm ci), en parallèle des dépendances Python…"
+  npm_log=$(mktemp)
+  (PUPPETEER_SKIP_DOWNLOAD=true npm ci --no-audit --no-fund --loglevel=error --prefer-offline >"$npm_log" 2>&1) &
+  npm_pid=$!
+fi
+wait_npm() {
+  # attend npm ci (s'il tourne) ; en cas d'échec, montre son journal et s'arrête
+  [ -n "$npm_pid" ] || return 0
+  if ! wait "$npm_pid"; then
+    log "ERREUR : npm ci a échoué ; fin du journal :"
+    tail -n 30 "$npm_log" >&2
+    exit 1
+  fi
+  npm_pid=""
+  rm -f "$npm_log"
+  echo "$want_npm" > "$stamp_npm"
+}
+trap '[ -n "$npm_pid" ] && kill "$npm_pid" 2>/dev/null; true' EXIT
+
 # --- Python -------------------------------------------------------------------------------------
 # PYTHON donné : ce Python (un .venv fait avec un autre est refait). Sinon : le .venv existant s'il est
 # d'un Python pris en charge, ou le premier Python pris en charge trouvé.
@@ -85,7 +110,7 @@ elif [ -n "$venv_v" ] && is_supported "$venv_v"; then
 else
   PYTHON_BIN=""
   seen=""
-  for candidate in python3 python3.12 python3.11 /usr/bin/python3; do
+  for candidate in python3 python3.13 python3.12 python3.11 /usr/bin/python3; do
     command -v "$candidate" >/dev/null || continue
     v=$(python_version "$candidate") || continue
     if is_supported "$v"; then PYTHON_BIN=$(command -v "$candidate"); break; fi
@@ -138,14 +163,8 @@ mkdir -p .venv/etc/ipython
 cmp -s scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.py \
   || cp scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.py
 
-# --- npm ----------------------------------------------------------------------------------------
-stamp_npm=node_modules/.lock.sha
-want_npm=$(sha256sum package-lock.json | cut -d' ' -f1)
-if [ ! -f "$stamp_npm" ] || [ "$(cat "$stamp_npm")" != "$want_npm" ]; then
-  log "installation des ressources npm (npm ci)…"
-  PUPPETEER_SKIP_DOWNLOAD=true npm ci --no-audit --no-fund --loglevel=error >&2
-  echo "$want_npm" > "$stamp_npm"
-fi
+# --- npm : fin --------------------------------------------------------------------------------
+wait_npm
 
 # --- ressources web locales ---------------------------------------------------------------------
 .venv/bin/python scripts/vendor_assets.py

@@ -6,7 +6,7 @@ ce n'est pas un dossier « _static » à la racine, que Jupyter Book injecterait
 - MathJax 3 : depuis node_modules/mathjax (npm) ;
 - BokehJS (noyau + curseurs) : depuis le paquet Python bokeh installé, donc exactement à la version
   qui produit les figures ; fichiers nommés avec la version (bokeh/bokeh-3.9.2.min.js…). L'extension
-  kalman_course.interactive.sphinx_ext vérifie à chaque construction qu'ils sont à jour et ne les
+  kalman_course.sphinx.sliders vérifie à chaque construction qu'ils sont à jour et ne les
   ajoute qu'aux pages qui contiennent une figure à curseurs.
 """
 
@@ -34,7 +34,7 @@ def copy_tree(src: Path, dst: Path) -> None:
 
 def copy_bokehjs() -> None:
     """Copie BokehJS du paquet bokeh installé dans book/vendor/bokeh/ (anciennes versions retirées)."""
-    from kalman_course.interactive.sphinx_ext import installed_bokehjs
+    from kalman_course.interactive.static import installed_bokehjs
 
     files = installed_bokehjs()
     target_dir = VENDOR / "bokeh"

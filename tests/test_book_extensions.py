@@ -12,8 +12,8 @@ import pytest
 from pybtex.database import parse_file
 
 import kalman_course.core.linalg as linalg
-from kalman_course.book_citations import FORMATTING_STYLE, author_year_label, register
-from kalman_course.book_listings import source_without_docstring
+from kalman_course.sphinx.citations import FORMATTING_STYLE, author_year_label, register
+from kalman_course.sphinx.listings import source_without_docstring
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -58,3 +58,59 @@ def test_french_bibliography_style(bib):
     assert text.startswith("Greg Welch et Gary Bishop. An introduction to the Kalman filter. Rapport technique")
     assert all(" and " not in t.split(". ")[0] for _, t in rendered.values())  # auteurs (les titres restent)
     assert "Technical Report" not in " ".join(t for _, t in rendered.values())
+
+
+# --------------------------------------------------------------------------- où vit le code Sphinx
+
+PACKAGE = ROOT / "kalman_course"
+SPHINX_LIBRARIES = {"sphinx", "docutils", "sphinxcontrib", "sphinx_book_theme", "pybtex", "pybtex_docutils"}
+
+
+def _imported_modules(source: str, package: str) -> set[str]:
+    """Modules importés par le code ``source`` d'un module du paquet ``package`` (« kalman_course.x ») ;
+    les imports relatifs sont résolus."""
+    import ast
+
+    parts = package.split(".") if package else []
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                module = ".".join(parts[: len(parts) - node.level + 1] + ([node.module] if node.module else []))
+                found.add(module)
+                found |= {f"{module}.{alias.name}" for alias in node.names}
+            else:
+                found.add(node.module)
+    return found
+
+
+def _package_of(path: Path) -> str:
+    return ".".join(path.relative_to(ROOT).parts[:-1])
+
+
+def test_sphinx_code_lives_in_kalman_course_sphinx_only():
+    """Tout le code Sphinx/docutils est dans kalman_course/sphinx/ ; aucun module du paquet ni script ne
+    l'importe (seul _config.yml le charge) ; les extensions déclarées sont exactement ses modules."""
+    import yaml
+
+    outside = [p for p in PACKAGE.rglob("*.py") if "sphinx" not in p.relative_to(PACKAGE).parts]
+    outside += list((ROOT / "scripts").glob("*.py"))
+    assert len(outside) > 50
+    for path in outside:
+        imported = _imported_modules(path.read_text(), _package_of(path))
+        sphinx_libs = {m for m in imported if m.split(".")[0] in SPHINX_LIBRARIES}
+        assert not sphinx_libs, f"{path.relative_to(ROOT)} importe {sorted(sphinx_libs)}"
+        ours = {m for m in imported if m == "kalman_course.sphinx" or m.startswith("kalman_course.sphinx.")}
+        assert not ours, f"{path.relative_to(ROOT)} importe {sorted(ours)}"
+    modules = sorted(f"kalman_course.sphinx.{p.stem}" for p in (PACKAGE / "sphinx").glob("*.py") if p.stem != "__init__")
+    declared = yaml.safe_load((ROOT / "_config.yml").read_text())["sphinx"]["extra_extensions"]
+    assert sorted(e for e in declared if e.startswith("kalman_course")) == modules
+
+
+def test_import_check_resolves_relative_imports():
+    """Le relevé des imports voit ``from ..sphinx import x`` écrit dans kalman_course/interactive/."""
+    found = _imported_modules("from ..sphinx import quiz\nfrom docutils import nodes\n", "kalman_course.interactive")
+    assert {"kalman_course.sphinx", "kalman_course.sphinx.quiz", "docutils"} <= found
+    assert _package_of(PACKAGE / "interactive" / "static.py") == "kalman_course.interactive"

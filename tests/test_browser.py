@@ -27,7 +27,7 @@ import playwright.sync_api as playwright_api
 import pytest
 
 import kalman_course.interactive as ki
-from kalman_course.book_typography import french_spacing
+from kalman_course.typography import french_spacing
 from kalman_course.numbers import format_spec
 from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
 

@@ -17,7 +17,8 @@ from conftest import ROOT, filterpy_kf
 
 import kalman_course as kc
 import kalman_course.interactive as ki
-from kalman_course.interactive import sphinx_ext
+from kalman_course.interactive.static import installed_bokehjs
+from kalman_course.sphinx import launch_buttons
 from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
 from kalman_course.scenarios import tag
 
@@ -307,18 +308,18 @@ LAUNCH = {"binderhub_url": "https://mybinder.org", "colab_url": "https://colab.r
           "jupyterhub_url": "", "thebe": False, "notebook_interface": "jupyterlab"}
 
 
-@pytest.mark.parametrize("url", ["", "  ", sphinx_ext.JUPYTER_BOOK_DEFAULT_REPOSITORY,
-                                 sphinx_ext.JUPYTER_BOOK_DEFAULT_REPOSITORY + "/"])
+@pytest.mark.parametrize("url", ["", "  ", launch_buttons.JUPYTER_BOOK_DEFAULT_REPOSITORY,
+                                 launch_buttons.JUPYTER_BOOK_DEFAULT_REPOSITORY + "/"])
 def test_launch_buttons_withheld_without_a_repository(url):
     config = _fake_config(url, LAUNCH)
-    sphinx_ext._guard_launch_buttons(None, config)
+    launch_buttons._guard_launch_buttons(None, config)
     assert config.html_theme_options["launch_buttons"] == {"notebook_interface": "jupyterlab"}
     assert config.kc_ipynb_download is True  # le bouton .ipynb reste
 
 
 def test_launch_buttons_kept_with_a_repository():
     config = _fake_config("https://github.com/exemple/filtre-de-kalman", LAUNCH)
-    sphinx_ext._guard_launch_buttons(None, config)
+    launch_buttons._guard_launch_buttons(None, config)
     assert config.html_theme_options["launch_buttons"] == LAUNCH
     assert config.kc_ipynb_download is False
 
@@ -327,7 +328,7 @@ def test_config_declares_the_extension_and_an_explicit_repository():
     import yaml
 
     cfg = yaml.safe_load((ROOT / "_config.yml").read_text())
-    assert "kalman_course.interactive.sphinx_ext" in cfg["sphinx"]["extra_extensions"]
+    assert {"kalman_course.sphinx.sliders", "kalman_course.sphinx.launch_buttons"} <= set(cfg["sphinx"]["extra_extensions"])
     assert "url" in cfg["repository"]  # jamais l'URL par défaut de Jupyter Book
     assert cfg["launch_buttons"]["binderhub_url"] and cfg["launch_buttons"]["colab_url"]
     vendor = [Path(ROOT, p) for p in cfg["sphinx"]["config"]["html_static_path"]]
@@ -335,7 +336,7 @@ def test_config_declares_the_extension_and_an_explicit_repository():
 
 
 def test_vendored_bokehjs_matches_the_installed_bokeh():
-    for served, source in sphinx_ext.installed_bokehjs().items():
+    for served, source in installed_bokehjs().items():
         vendored = ROOT / "book" / "vendor" / served
         assert vendored.is_file(), f"{vendored} absent : lancez python scripts/vendor_assets.py"
         assert vendored.read_bytes() == source.read_bytes()

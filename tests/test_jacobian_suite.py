@@ -16,7 +16,7 @@ import pytest
 import scipy.linalg
 
 import kalman_course as kc
-from kalman_course.figures.ekf import polar_to_cartesian, polar_to_cartesian_jacobian
+from kalman_course.scenarios.polar import polar_to_cartesian, polar_to_cartesian_jacobian
 from kalman_course.geometry import camera as cam
 from kalman_course.geometry import lie
 from kalman_course.scenarios import radar, tag

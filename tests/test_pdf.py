@@ -15,10 +15,8 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -26,16 +24,15 @@ import pytest
 import yaml
 from PIL import Image
 
-from conftest import BUILD_REPORT, ROOT, run_jupyter_book, tree_state
+from conftest import ROOT, latex_pdf, tex_missing, tree_state
 from kalman_course.numbers import format_spec
 
 sys.path.insert(0, str(ROOT / "scripts"))
-from pdf import TARGET, compile_pdf  # noqa: E402
+from pdf import TARGET  # noqa: E402
 
 pytestmark = pytest.mark.pdf
 
 BOOK = ROOT / "book"
-TOOLS = ("xelatex", "latexmk", "pdftotext", "pdfinfo", "pdfimages")
 
 
 def _toc_docs() -> list[str]:
@@ -66,20 +63,18 @@ def _flat(text: str) -> str:
 
 @pytest.fixture(scope="module")
 def pdf_build(book_build_dir):
-    missing = [tool for tool in TOOLS if shutil.which(tool) is None]
+    """Le PDF construit en arrière-plan dès la fin de la construction du site (tests/conftest.py :
+    construction LaTeX sur le même environnement Sphinx et le même cache d'exécution, puis XeLaTeX)."""
+    missing = tex_missing()
     if missing:
         message = (f"TeX Live ou poppler-utils absent ({', '.join(missing)}) : "
                    "« bash scripts/setup.sh --pdf » les installe.")
         if os.environ.get("CI"):
             pytest.fail(message)
         pytest.skip(message)
-    start = time.perf_counter()
-    log = run_jupyter_book(book_build_dir, "--builder", "latex", label="construction LaTeX (tests)")
+    log, pdf, compile_s = latex_pdf(book_build_dir)
     latex_dir = book_build_dir / "_build" / "latex"
-    pdf, compile_s = compile_pdf(latex_dir, book_build_dir / "_build" / "pdf" / f"{TARGET}.pdf")
-    total = time.perf_counter() - start
-    BUILD_REPORT.append(f"PDF : {total:.0f} s au total, dont {compile_s:.0f} s de XeLaTeX (latexmk) → {pdf}")
-    print(f"\nPDF construit en {format_spec(total, '.0f')} s (XeLaTeX : {format_spec(compile_s, '.0f')} s) : {pdf}")
+    print(f"\nPDF construit (XeLaTeX : {format_spec(compile_s, '.0f')} s) : {pdf}")
     text = subprocess.run(["pdftotext", "-enc", "UTF-8", str(pdf), "-"], check=True, capture_output=True,
                           text=True).stdout
     info = subprocess.run(["pdfinfo", str(pdf)], check=True, capture_output=True, text=True).stdout

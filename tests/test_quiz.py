@@ -1,4 +1,4 @@
-"""La directive ``quiz`` (kalman_course.interactive.quiz) : HTML corrigé dans la page, LaTeX avec les
+"""La directive ``quiz`` (kalman_course.sphinx.quiz) : HTML corrigé dans la page, LaTeX avec les
 réponses en fin de chapitre, erreurs de rédaction qui arrêtent la construction. Un petit projet Sphinx
 (MyST) est construit dans un dossier temporaire ; le livre lui-même est vérifié par tests/test_browser.py."""
 
@@ -11,10 +11,10 @@ from pathlib import Path
 import pytest
 from sphinx.cmd.build import build_main
 
-from kalman_course.interactive.quiz import QUIZ_MARKER
+from kalman_course.sphinx.quiz import QUIZ_MARKER
 
 CONF = """
-extensions = ["myst_parser", "kalman_course.interactive.quiz"]
+extensions = ["myst_parser", "kalman_course.sphinx.quiz"]
 myst_enable_extensions = ["colon_fence", "dollarmath"]
 language = "fr"
 root_doc = "index"

@@ -1,4 +1,4 @@
-"""Typographie française du livre (kalman_course.book_typography) : règles sur des chaînes écrites à la
+"""Typographie française du livre (kalman_course.typography et son extension Sphinx kalman_course.sphinx.typography) : règles sur des chaînes écrites à la
 main, et transformation d'un document docutils qui laisse intacts code, formules et HTML brut."""
 
 from __future__ import annotations
@@ -6,7 +6,8 @@ from __future__ import annotations
 from docutils import nodes
 from docutils.core import publish_doctree
 
-from kalman_course.book_typography import french_spacing, typeset
+from kalman_course.sphinx.typography import typeset
+from kalman_course.typography import french_spacing
 
 NB, NN = "\u00a0", "\u202f"
 

@@ -84,21 +84,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def write_figure(name: str, out: Path, formats: list[str], dpi: int) -> int:
-    """Dessine la figure ``name`` et l'écrit dans ``out`` dans chaque format ; renvoie le nombre de
-    fichiers écrits. Date retirée des métadonnées et identifiants SVG déterministes (réglage local à
-    cet appel) : deux régénérations écrivent les mêmes octets, quel que soit le processus. L'algèbre
-    linéaire (BLAS) n'utilise qu'un fil pendant l'appel (threadpoolctl)."""
+def draw_single_threaded(name: str):
+    """:func:`~kalman_course.figures.draw` avec une algèbre linéaire (BLAS) sur un seul fil (threadpoolctl)."""
     from threadpoolctl import threadpool_limits
 
     # BLAS sur un seul fil : les figures tournent déjà en parallèle (un processus par cœur) ; les fils
     # d'OpenBLAS en plus se disputent les cœurs (attente active) et multiplient le temps CPU des gros
     # produits (nuages de particules) sans rien changer aux résultats.
-    with threadpool_limits(limits=1, user_api="blas"), matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
-        fig = draw(name)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return draw(name)
+
+
+def save_figure(fig, name: str, out: Path, formats: list[str], dpi: int) -> int:
+    """Écrit la figure ``fig`` dans ``out/name.<format>`` pour chaque format ; renvoie le nombre de
+    fichiers écrits. Date retirée des métadonnées et identifiants SVG déterministes (réglage local à
+    cet appel) : deux régénérations écrivent les mêmes octets, quel que soit le processus."""
+    with matplotlib.rc_context({"svg.hashsalt": "kalman-course"}):
         for fmt in formats:
             fig.savefig(out / f"{name}.{fmt}", dpi=dpi, metadata=_FIXED_METADATA[fmt], **_SAVE_OPTIONS[fmt])
     return len(formats)
+
+
+def write_figure(name: str, out: Path, formats: list[str], dpi: int) -> int:
+    """Dessine la figure ``name`` (:func:`draw_single_threaded`) et l'écrit dans ``out`` dans chaque format
+    (:func:`save_figure`) ; renvoie le nombre de fichiers écrits."""
+    return save_figure(draw_single_threaded(name), name, out, formats, dpi)
 
 
 def write_figures(names: list[str], out: Path, formats: list[str], dpi: int) -> int:

@@ -6,26 +6,15 @@ import numpy as np
 import scipy.linalg
 import scipy.stats
 
-from ..lecture.errata import printed_recipe_filter
-from ..lecture.estimator import covariance_for_gain
-from ..filters.kalman import kalman_filter
-from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
-from ..scenarios.engine import (
-    ENGINE_DT,
-    ENGINE_P0,
-    ENGINE_SEED,
-    ENGINE_X0_HAT,
-    ENGINE_X0_MEAN,
-    engine_commands,
-    engine_model,
-)
-from ..core.simulation import simulate
-from ..scenarios.engine import LIMIT_SCALES, gain_limit_run, gain_limit_sweep
-from ..scenarios.voltage import posterior_experiment
+from ..scenarios import TRUE_VOLTAGE
+from ..scenarios.engine import ENGINE_DT, LIMIT_SCALES, engine_model, gain_limit_run, gain_limit_sweep
+from ..scenarios.gain_trace import engine_trace_ratios, gain_trace
+from ..scenarios.voltage import posterior_coverage, printed_recipe_comparison
 from ._registry import new_figure, register
 
 CHAPTER_LOOP = "predicteur-correcteur"
 CHAPTER_OPTIMAL = "gain-optimal"
+
 
 @register("gain-limites", chapter=CHAPTER_LOOP, title="Limites du gain : K → 0 et K → C⁻¹")
 def gain_limits_figure():
@@ -57,16 +46,9 @@ def gain_limits_figure():
     return fig
 
 
-def printed_recipe_runs(n_steps: int = 50):
-    """Tension constante : le filtre de Kalman (recette corrigée) et la recette au gain imprimé (001-7)."""
-    model = constant_voltage_model()
-    z = constant_voltage_measurements(n_steps)
-    return z, kalman_filter(model, z, 0.0, 1.0), printed_recipe_filter(model, z, 0.0, 1.0)
-
-
 @register("recette-gain-imprime", chapter=CHAPTER_LOOP, title="La recette imprimée (Ψ au lieu de Φ) contre la recette corrigée")
 def printed_recipe_figure():
-    z, good, bad = printed_recipe_runs()
+    z, good, bad = printed_recipe_comparison()
     n = np.arange(1, z.size + 1)
     fig, (ax_k, ax_x) = new_figure(2, 1, width=7.0, height=6.0, sharex=True)
     ax_k.plot(n, good.K[:, 0, 0], "o-", ms=3, color="tab:blue", label=r"gain corrigé $P^-(P^-+\Psi)^{-1}$")
@@ -86,45 +68,20 @@ def printed_recipe_figure():
     return fig
 
 
-def trace_curves(n_directions: int = 6, step: int = 5, seed: int = 7):
-    r"""Trace de :math:`P_{n+1}(K)` autour du gain de Kalman :math:`K^\star`, pour le moteur au pas ``step``.
-
-    Renvoie ``(t, ratios)`` : ``ratios[j, i]`` = :math:`\mathrm{tr}\,P(K^\star + t_i D_j)/\mathrm{tr}\,P(K^\star)`
-    pour des directions aléatoires :math:`D_j` de norme :math:`\|K^\star\|`.
-    """
-    model = engine_model()
-    u = engine_commands(step)
-    sim = simulate(model, ENGINE_X0_MEAN, step, u, rng=ENGINE_SEED)
-    res = kalman_filter(model, sim.y, ENGINE_X0_HAT, ENGINE_P0, u)
-    P_pred, K_star = res.P_pred[-1], res.K[-1]
-    rng = np.random.default_rng(seed)
-    t = np.linspace(-1.0, 1.0, 81)
-    base = np.trace(covariance_for_gain(model, P_pred, K_star))
-    ratios = []
-    for _ in range(n_directions):
-        D = rng.standard_normal(K_star.shape)
-        D *= np.linalg.norm(K_star) / np.linalg.norm(D)
-        ratios.append([np.trace(covariance_for_gain(model, P_pred, K_star + ti * D)) / base for ti in t])
-    return t, np.array(ratios)
-
-
 @register("gain-trace-minimale", chapter=CHAPTER_OPTIMAL, title="Le gain de Kalman minimise la trace de P")
 def trace_figure():
     fig, (ax1, ax2) = new_figure(1, 2, width=7.5, height=3.6)
-    model = constant_voltage_model()
-    run = kalman_filter(model, constant_voltage_measurements(10), 0.0, 1.0)
-    P_pred, K_star = run.P_pred[-1, 0, 0], run.K[-1, 0, 0]
     Ks = np.linspace(0.0, 0.4, 201)
-    P_of_K = [covariance_for_gain(model, [[P_pred]], [[k]])[0, 0] for k in Ks]
+    P_of_K = [gain_trace(10, k).P for k in Ks]  # tension constante, pas n = 10
+    optimum = gain_trace(10, 0.0)
     ax1.plot(Ks, 1e3 * np.array(P_of_K), color="tab:blue", lw=1.8, label=r"$(1-K)^2P^-_{10} + K^2\Psi$")
-    ax1.plot([K_star], [1e3 * covariance_for_gain(model, [[P_pred]], [[K_star]])[0, 0]], "o", color="tab:red",
-             label=r"gain de Kalman $K_{10}$")
+    ax1.plot([optimum.K_star], [1e3 * optimum.P_star], "o", color="tab:red", label=r"gain de Kalman $K_{10}$")
     ax1.set_xlabel("gain K (sans unité)")
     ax1.set_ylabel(r"$P_{10}(K)$ ($10^{-3}$ V²)")
     ax1.set_title(r"Tension constante, pas $n = 10$", fontsize=10)
     ax1.legend(fontsize=8)
     ax1.grid(alpha=0.3)
-    t, ratios = trace_curves()
+    t, ratios = engine_trace_ratios()
     for r in ratios:
         ax2.plot(t, r, lw=1.2)
     ax2.plot([0.0], [1.0], "o", color="tab:red", label=r"$K^\star$ (Kalman)")
@@ -138,9 +95,8 @@ def trace_figure():
 
 @register("gain-loi-a-posteriori", chapter=CHAPTER_OPTIMAL, title="La loi a posteriori N(x̂ₙ, Pₙ) vérifiée par Monte-Carlo")
 def posterior_figure():
-    mc, P = posterior_experiment()
-    err = mc.x[:, :, 0] - mc.x_hat[:, :, 0]  # (R, T)
-    z = err / np.sqrt(P)[None, :]
+    post = posterior_coverage()
+    mc, z = post.monte_carlo, post.normalised  # (R, T)
     fig, (ax1, ax2) = new_figure(1, 2, width=7.5, height=3.6)
     ax1.hist(z[:, -1], bins=40, density=True, color="tab:blue", alpha=0.6, label=f"{mc.n_runs} tirages")
     grid = np.linspace(-4, 4, 201)
@@ -150,8 +106,7 @@ def posterior_figure():
     ax1.set_title("Erreur normalisée après 50 relevés")
     ax1.legend(fontsize=8)
     ax1.grid(alpha=0.3)
-    q = scipy.stats.norm.ppf(0.975)
-    coverage = 100 * np.mean(np.abs(z) <= q, axis=0)
+    coverage = 100 * post.coverage
     n = np.arange(1, z.shape[1] + 1)
     band = 100 * 1.96 * np.sqrt(0.95 * 0.05 / mc.n_runs)
     ax2.fill_between(n, 95 - band, 95 + band, color="tab:red", alpha=0.15, label="95 % ± 2 écarts-types de MC")

@@ -4,39 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..filters.kalman import kalman_filter
-from ..core.models import LinearGaussianModel
-from ..scenarios.engine import (
-    ENGINE_DT,
-    ENGINE_P0,
-    ENGINE_SEED,
-    ENGINE_X0_HAT,
-    ENGINE_X0_MEAN,
-    engine_commands,
-    engine_model,
-)
-from ..core.simulation import simulate
+from ..scenarios.engine import ENGINE_DT, forgotten_command
 from ._registry import new_figure, register
 
 CHAPTER = "pratique-synthese"
 
 
-def innovation_runs(n_steps: int = 120):
-    r"""Moteur simulé, filtré deux fois : avec le bon modèle, puis avec un modèle qui ignore la commande
-    (pas de :math:`B`). Renvoie ``(normalised_good, normalised_bad)``, innovations normalisées
-    :math:`\nu_{n,1} / \sqrt{S_{n,11}}` du premier capteur, formes (T,)."""
-    model = engine_model()
-    u = engine_commands(n_steps)
-    sim = simulate(model, ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
-    good = kalman_filter(model, sim.y, ENGINE_X0_HAT, ENGINE_P0, u)
-    no_command = LinearGaussianModel(model.A, model.C, model.Q, model.R)
-    bad = kalman_filter(no_command, sim.y, ENGINE_X0_HAT, ENGINE_P0)
-    return tuple(r.innovation[:, 0] / np.sqrt(r.S[:, 0, 0]) for r in (good, bad))
-
-
 @register("pratique-innovations", chapter=CHAPTER, title="Innovations normalisées : modèle juste ou modèle incomplet")
 def innovations_figure():
-    good, bad = innovation_runs()
+    run = forgotten_command()
+    good, bad = run.normalised_good, run.normalised_bad
     t = ENGINE_DT * np.arange(1, good.size + 1)
     fig, axes = new_figure(2, 1, width=7.0, height=5.6, sharex=True, sharey=True)
     for ax, data, color, title in (

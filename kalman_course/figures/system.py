@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..scenarios.engine import ENGINE_DT, ENGINE_SEED, engine_commands, engine_model
-from ..core.simulation import simulate
+from ..scenarios.engine import ENGINE_DT, engine_commands, engine_simulation
 from ._registry import new_figure, register
 
 CHAPTER = "controle-systeme"
@@ -13,9 +12,8 @@ CHAPTER = "controle-systeme"
 
 @register("systeme-moteur", chapter=CHAPTER, title="État, commande et mesure du moteur simulé")
 def engine_system():
-    model = engine_model()
     u = engine_commands(120)
-    sim = simulate(model, np.zeros(2), u.shape[0], u, rng=ENGINE_SEED)
+    sim = engine_simulation(120)
     t = ENGINE_DT * np.arange(1, u.shape[0] + 1)
     fig, axes = new_figure(3, 1, width=7.0, height=7.0, sharex=True)
     ax_u, ax_x, ax_y = axes

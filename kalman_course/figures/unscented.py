@@ -9,7 +9,7 @@ from ..filters.unscented import sigma_weights
 from ..numbers import format_number
 from ..scenarios import banana
 from ..scenarios.distant_target import distant_target_comparison
-from ..scenarios.tag import TAG_TRANSIENT_STEPS, position_rmse, run_tag_ekf, run_tag_ukf, tag_data
+from ..scenarios.tag import TAG_TRANSIENT_STEPS, tag_comparison
 from ._geometry import draw_ellipse
 from ._registry import new_figure, register
 
@@ -22,11 +22,10 @@ COLORS = {"truth": "k", "linearized": "tab:red", "unscented": "tab:blue"}
           title="La « banane » : loi polaire vue en cartésien — vérité, linéarisation, transformée sans parfum")
 def ukf_banana():
     comp = banana.banana_comparison()
-    cloud = banana.banana_sample(3000)
+    polar = banana.banana_polar_sample(3000)
+    cloud = banana.polar_to_cartesian(polar)
     r0, th0 = banana.BANANA_RANGE, banana.BANANA_BEARING
     sr, st = banana.BANANA_RANGE_STD, banana.BANANA_BEARING_STD
-    z = np.random.default_rng(banana.BANANA_SEED).standard_normal((3000, 2))
-    polar = np.column_stack([r0 + sr * z[:, 0], th0 + st * z[:, 1]])
 
     fig, (ax0, ax1) = new_figure(1, 2, width=10.0, height=5.4, gridspec_kw={"width_ratios": [1, 1.6]})
     ax0.plot(polar[:, 0], np.rad2deg(polar[:, 1]), ".", ms=1.5, color="0.6", alpha=0.5)
@@ -127,17 +126,13 @@ def ukf_distant_target():
 
 @register("ukf-comparaison", chapter=CHAPTER, title="Tag UWB : EKF et UKF sur les mêmes mesures")
 def ukf_comparison():
-    data = tag_data()
-    ekf = run_tag_ekf(data=data)
-    ukf = run_tag_ukf(data=data)
-    e_ekf = np.linalg.norm(ekf.x[:, :2] - data.x_true[:, :2], axis=1)
-    e_ukf = np.linalg.norm(ukf.x[:, :2] - data.x_true[:, :2], axis=1)
-    gap = np.linalg.norm(ekf.x[:, :2] - ukf.x[:, :2], axis=1)
+    run = tag_comparison()
+    data, gap = run.data, run.gap
     fig, (ax, ad) = new_figure(2, 1, width=7.5, height=5.2, sharex=True)
-    ax.plot(data.t, 100 * e_ekf, color="tab:red", lw=1.4,
-            label=f"EKF (erreur quadratique moyenne {format_number(100 * position_rmse(ekf.x, data.x_true), decimals=2)} cm)")
-    ax.plot(data.t, 100 * e_ukf, color="tab:blue", lw=1.0, ls="--",
-            label=f"UKF (erreur quadratique moyenne {format_number(100 * position_rmse(ukf.x, data.x_true), decimals=2)} cm)")
+    ax.plot(data.t, 100 * run.ekf_error, color="tab:red", lw=1.4,
+            label=f"EKF (erreur quadratique moyenne {format_number(100 * run.ekf_rmse, decimals=2)} cm)")
+    ax.plot(data.t, 100 * run.ukf_error, color="tab:blue", lw=1.0, ls="--",
+            label=f"UKF (erreur quadratique moyenne {format_number(100 * run.ukf_rmse, decimals=2)} cm)")
     ax.axvspan(0, data.t[TAG_TRANSIENT_STEPS - 1], color="0.85", label="régime transitoire (exclu)")
     ax.set_ylim(0, 30)
     ax.set_ylabel(r"erreur de position $\|\hat p - p\|$ (cm)")

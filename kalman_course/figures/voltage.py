@@ -4,22 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..filters.kalman import kalman_filter
-from ..scenarios import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
+from ..scenarios import TRUE_VOLTAGE
+from ..scenarios.voltage import voltage_run
 from ..numbers import format_spec as fr
 from ._registry import new_figure, register
 
 CHAPTER = "tension-constante"
 
 
-def _voltage_run(R: float, Q: float = 1e-5, P0: float = 1.0, n_steps: int = 50):
-    z = constant_voltage_measurements(n_steps)
-    result = kalman_filter(constant_voltage_model(Q=Q, R=R), z, x0=0.0, P0=P0)
-    return z, result
-
-
 def _voltage_panel(ax, R: float, title: str) -> None:
-    z, result = _voltage_run(R)
+    z, result = voltage_run(R)
     n = np.arange(1, z.size + 1)
     ax.axhline(TRUE_VOLTAGE, color="tab:green", lw=1.5, label=f"valeur vraie x = {fr(TRUE_VOLTAGE, 'g')} V")
     ax.plot(n, z, "+", color="tab:red", ms=7, label="mesures $y_n$")
@@ -40,7 +34,7 @@ def voltage_estimation():
 
 @register("tension-covariance", chapter=CHAPTER, title="Convergence de la covariance de l'erreur Pₙ")
 def voltage_covariance():
-    _, result = _voltage_run(R=0.01)
+    _, result = voltage_run(R=0.01)
     n = np.arange(1, result.n_steps + 1)
     fig, ax = new_figure()
     ax.plot(n, result.P[:, 0, 0], color="tab:blue", lw=1.8, label=r"$P_n$ (a posteriori)")

@@ -14,9 +14,8 @@ UWB), :func:`nile_sliders`, :func:`live_nile_explorer` (le Nil, chapitre « Liss
 :func:`banana_uncertainty_sliders`, :func:`banana_parameter_sliders` (la « banane » de l'UKF) et
 :func:`particle_sliders` (le filtre particulaire) ; elles sont aussi au registre.
 
-:mod:`.grid` : les grilles précalculées (numpy seulement) ; :mod:`.sphinx_ext` : l'extension Sphinx qui
-sert BokehJS aux pages qui en ont besoin ; :mod:`.quiz` : la directive ``quiz`` des questionnaires
-corrigés dans la page.
+:mod:`.grid` : les grilles précalculées (numpy seulement). Le livre sert BokehJS aux pages qui en ont
+besoin par l'extension Sphinx :mod:`kalman_course.sphinx.sliders` (aucun code Sphinx ici).
 
 Seul ce sous-paquet importe bokeh et ipywidgets.
 """

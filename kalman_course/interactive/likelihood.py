@@ -14,6 +14,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..datasets.nile import nile
+from ..diagnostics.consistency import whitened_innovations
 from ..likelihood import log_likelihood
 from ..scenarios.nile import local_level_model, nile_fit, nile_run
 from .figure import SliderSpec, number, register_sliders
@@ -44,10 +45,8 @@ def likelihood_run(R: float, Q: float) -> dict[str, np.ndarray]:
     """Profil de :math:`\\log L` le long de :math:`Q`, valeur au point choisi, innovations normalisées."""
     run = nile_run(R, Q, missing=False)
     f = run.filtered
-    with np.errstate(invalid="ignore", divide="ignore"):
-        normalised = f.innovation[:, 0] / np.sqrt(f.S[:, 0, 0])
-    normalised[~np.isfinite(normalised)] = np.nan
-    normalised[0] = np.nan  # le pas diffus : pas d'innovation informative
+    normalised = np.full(len(f.x), np.nan)  # les pas diffus : pas d'innovation informative
+    normalised[f.n_diffuse:] = whitened_innovations(f.after_diffuse())[:, 0]
     return {
         "profile": _profile(float(R)),
         "Q_now": np.array([Q]),

@@ -6,7 +6,7 @@ La page publiée n'a pas de noyau : la figure embarque toute une :class:`~.grid.
 
 BokehJS n'est **pas** inclus dans la figure : le site le sert lui-même, une fois pour tout le site,
 dans ``_static/bokeh/`` (copié du paquet Python ``bokeh`` installé par ``scripts/vendor_assets.py``,
-donc à la même version). L'extension Sphinx :mod:`kalman_course.interactive.sphinx_ext` ajoute les
+donc à la même version). L'extension Sphinx :mod:`kalman_course.sphinx.sliders` ajoute les
 balises ``<script>`` dans l'en-tête des seules pages qui contiennent une telle figure (repérées par
 l'attribut :data:`MARKER`), une fois par page, avec un chemin relatif qui marche en ``http://`` comme
 en ``file://``. Hors du livre (dans Jupyter), la figure affiche un message qui renvoie vers les
@@ -26,6 +26,7 @@ import itertools
 import json
 import re
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable, Mapping
 
 import bokeh
@@ -45,7 +46,7 @@ from bokeh.models import (
 from bokeh.plotting import figure
 
 from ..core.validation import KalmanInputError, as_float_array
-from ..book_typography import french_spacing
+from ..typography import french_spacing
 from ..numbers import bokeh_tick_formatter
 from .grid import ParameterGrid
 from .spec import Panel, check_columns
@@ -67,6 +68,15 @@ PLOTTED_SOURCE = "kc-plotted"
 def bokehjs_files() -> list[str]:
     """Fichiers BokehJS nécessaires, relatifs à ``_static/`` : noyau puis composants (curseurs)."""
     return [f"bokeh/bokeh-{BOKEH_VERSION}.min.js", f"bokeh/bokeh-widgets-{BOKEH_VERSION}.min.js"]
+
+
+def installed_bokehjs() -> dict[str, Path]:
+    """Fichiers BokehJS du paquet Python ``bokeh`` installé : nom servi (:func:`bokehjs_files`) → chemin
+    source (copiés par ``scripts/vendor_assets.py``, vérifiés par l'extension du livre)."""
+    from bokeh.util.paths import bokehjs_path
+
+    js = Path(bokehjs_path()) / "js"
+    return dict(zip(bokehjs_files(), [js / "bokeh.min.js", js / "bokeh-widgets.min.js"]))
 
 
 # Rappel exécuté par le navigateur à chaque mouvement d'un curseur : l'exécution d'indice plat

@@ -8,6 +8,7 @@ from .voltage import (
     constant_voltage_model,
 )
 from . import engine, radar, tag  # noqa: F401  (moteur 2×2 ; suivi du tag UWB ; radar de l'EKF itéré)
+from . import sensor_tuning  # noqa: F401  (thermocouple mal réglé : chapitre « Implémentation pratique »)
 from . import camera_target  # noqa: F401  (pose d'une cible vue par une caméra, EKF itéré sur SE(3))
 from . import diffuse  # noqa: F401  (départ sans a priori : SRIF contre filtre de Kalman)
 from . import nile, smoothing  # noqa: F401  (le Nil et le niveau local ; la cible du lissage)
@@ -32,6 +33,7 @@ __all__ = [
     "radar",
     "radar_iterations",
     "radar_update_problem",
+    "sensor_tuning",
     "run_tag_ekf",
     "run_tag_ukf",
     "tag",

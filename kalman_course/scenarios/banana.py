@@ -26,6 +26,7 @@ from ..core.results import freeze_fields
 from ..core.simulation import as_generator, check_positive_int
 from ..core.validation import KalmanInputError
 from ..filters.unscented import unscented_transform
+from .polar import polar_to_cartesian, polar_to_cartesian_jacobian
 
 __all__ = [
     "BANANA_RANGE",
@@ -36,14 +37,13 @@ __all__ = [
     "BANANA_BETA",
     "BANANA_KAPPA",
     "BANANA_SEED",
-    "polar_to_cartesian",
-    "polar_jacobian",
     "Moments",
     "BananaComparison",
     "banana_truth",
     "banana_linearized",
     "banana_unscented",
     "banana_comparison",
+    "banana_polar_sample",
     "banana_sample",
     "mean_error_orders",
 ]
@@ -62,19 +62,6 @@ BANANA_BETA = 2.0
 BANANA_KAPPA = 1.0
 #: Graine du nuage de Monte-Carlo.
 BANANA_SEED = 11
-
-
-def polar_to_cartesian(p: Any) -> np.ndarray:
-    r""":math:`g(r, \theta) = (r\cos\theta, r\sin\theta)` (m) ; ``p`` (2,) ou pile (N, 2)."""
-    p = np.asarray(p, dtype=float)
-    r, theta = p[..., 0], p[..., 1]
-    return np.stack([r * np.cos(theta), r * np.sin(theta)], axis=-1)
-
-
-def polar_jacobian(p: Any) -> np.ndarray:
-    r"""Jacobienne :math:`J = \begin{bmatrix}\cos\theta & -r\sin\theta\\ \sin\theta & r\cos\theta\end{bmatrix}` (2, 2)."""
-    r, theta = float(p[0]), float(p[1])
-    return np.array([[np.cos(theta), -r * np.sin(theta)], [np.sin(theta), r * np.cos(theta)]])
 
 
 @dataclass(frozen=True, eq=False)
@@ -116,7 +103,7 @@ def banana_linearized(
 ) -> Moments:
     r"""Linéarisation en :math:`(\bar r, \bar\theta)` : :math:`g(\bar r, \bar\theta)` et :math:`J\,\mathrm{diag}(\sigma_r^2, \sigma_\theta^2)J^T`."""
     sr, st = _check_std("range_std", range_std), _check_std("bearing_std", bearing_std)
-    J = polar_jacobian([r, bearing])
+    J = polar_to_cartesian_jacobian([r, bearing])
     return Moments(polar_to_cartesian([r, bearing]), J @ np.diag([sr**2, st**2]) @ J.T)
 
 
@@ -132,15 +119,25 @@ def banana_unscented(
                                alpha=alpha, beta=beta, kappa=kappa, vectorized=True)
 
 
+def banana_polar_sample(
+    n: int = 2000, range_std: float = BANANA_RANGE_STD, bearing_std: float = BANANA_BEARING_STD,
+    rng: Any = BANANA_SEED, r: float = BANANA_RANGE, bearing: float = BANANA_BEARING,
+) -> np.ndarray:
+    r"""Tirages polaires (n, 2) :math:`(r_j, \theta_j)` (m, rad) de :math:`\mathcal N((\bar r, \bar\theta),
+    \mathrm{diag}(\sigma_r^2, \sigma_\theta^2))`."""
+    n = check_positive_int("n", n)
+    sr, st = _check_std("range_std", range_std), _check_std("bearing_std", bearing_std)
+    z = as_generator(rng).standard_normal((n, 2))
+    return np.column_stack([r + sr * z[:, 0], bearing + st * z[:, 1]])
+
+
 def banana_sample(
     n: int = 2000, range_std: float = BANANA_RANGE_STD, bearing_std: float = BANANA_BEARING_STD,
     rng: Any = BANANA_SEED, r: float = BANANA_RANGE, bearing: float = BANANA_BEARING,
 ) -> np.ndarray:
-    r"""Nuage de Monte-Carlo (n, 2) : :math:`g(r_j, \theta_j)` pour :math:`n` tirages polaires."""
-    n = check_positive_int("n", n)
-    sr, st = _check_std("range_std", range_std), _check_std("bearing_std", bearing_std)
-    z = as_generator(rng).standard_normal((n, 2))
-    return polar_to_cartesian(np.column_stack([r + sr * z[:, 0], bearing + st * z[:, 1]]))
+    r"""Nuage de Monte-Carlo (n, 2) : :math:`g(r_j, \theta_j)` pour les :math:`n` tirages polaires de
+    :func:`banana_polar_sample`."""
+    return polar_to_cartesian(banana_polar_sample(n, range_std, bearing_std, rng, r, bearing))
 
 
 @dataclass(frozen=True, eq=False)

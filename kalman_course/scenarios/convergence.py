@@ -11,6 +11,7 @@ Modèle : un mobile à vitesse presque constante sur une droite (état position,
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -21,6 +22,7 @@ from ..core.simulation import as_generator, check_positive_int, simulate
 from ..filters.ensemble import ensemble_kalman_filter
 from ..filters.kalman import kalman_filter
 from ..filters.particle import particle_filter
+from ..likelihood import filter_log_likelihood
 
 __all__ = [
     "LINEAR_STEPS",
@@ -120,18 +122,12 @@ def loglog_slope(sizes: Any, errors: Any) -> float:
     return float(np.polyfit(np.log(np.asarray(sizes, dtype=float)), np.log(np.asarray(errors, dtype=float)), 1)[0])
 
 
-def _kalman_log_likelihood(result) -> float:
-    nu, S = result.innovation, result.S
-    return float(sum(-0.5 * (len(v) * np.log(2 * np.pi) + np.linalg.slogdet(s)[1] + v @ np.linalg.solve(s, v))
-                     for v, s in zip(nu, S)))
-
-
 def _convergence(run, sizes, n_runs, rng, bench, loglik: bool) -> Convergence:
     n_runs = check_positive_int("n_runs", n_runs)
     sizes = np.array([check_positive_int("taille", int(s)) for s in sizes])
     gen = as_generator(rng)
     ref = kalman_filter(bench.model, bench.y, bench.x0, bench.P0)
-    ll_ref = _kalman_log_likelihood(ref)
+    ll_ref = filter_log_likelihood(ref)
     mean_err, cov_err, ll_err = [], [], []
     for N in sizes:
         m2 = c2 = l2 = 0.0
@@ -147,26 +143,45 @@ def _convergence(run, sizes, n_runs, rng, bench, loglik: bool) -> Convergence:
     return Convergence(sizes.astype(float), np.array(mean_err), np.array(cov_err), np.array(ll_err), n_runs)
 
 
+def _particle_run(b, N, g):
+    return particle_filter(b.nonlinear, b.y, b.x0, b.P0, n_particles=N, rng=g)
+
+
+def _ensemble_run(b, N, g):
+    return ensemble_kalman_filter(b.nonlinear, b.y, b.x0, b.P0, n_members=N, rng=g)
+
+
+@lru_cache(maxsize=4)
+def _seeded_convergence(run, sizes: tuple, n_runs: int, rng: int, loglik: bool) -> Convergence:
+    return _convergence(run, sizes, n_runs, rng, linear_benchmark(), loglik)
+
+
+def _cached_convergence(run, sizes, n_runs, rng, bench, loglik: bool) -> Convergence:
+    """L'expérience de convergence, calculée une fois par processus quand elle est entièrement déterminée
+    (banc d'essai par défaut, graine entière) : le chapitre et sa figure la partagent (résultat immuable)."""
+    if bench is None and isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):
+        try:
+            key = (tuple(np.asarray(sizes).ravel().tolist()), n_runs, int(rng))
+            hash(key)
+        except (TypeError, ValueError):
+            key = None
+        if key is not None:
+            return _seeded_convergence(run, *key, loglik)
+    return _convergence(run, sizes, n_runs, rng, linear_benchmark() if bench is None else bench, loglik)
+
+
 def particle_convergence(sizes: Any = PARTICLE_SIZES, n_runs: int = 6, rng: Any = 1,
                          bench: LinearBenchmark | None = None) -> Convergence:
     r"""Filtre particulaire (systématique, :math:`\tau = 0{,}5`) contre le filtre de Kalman sur le banc
     d'essai linéaire, pour chaque nombre de particules de ``sizes`` (``n_runs`` graines chacun)."""
-    bench = linear_benchmark() if bench is None else bench
-    return _convergence(
-        lambda b, N, g: particle_filter(b.nonlinear, b.y, b.x0, b.P0, n_particles=N, rng=g),
-        sizes, n_runs, rng, bench, loglik=True,
-    )
+    return _cached_convergence(_particle_run, sizes, n_runs, rng, bench, loglik=True)
 
 
 def ensemble_convergence(sizes: Any = ENSEMBLE_SIZES, n_runs: int = 6, rng: Any = 2,
                          bench: LinearBenchmark | None = None) -> Convergence:
     r"""EnKF stochastique contre le filtre de Kalman sur le banc d'essai linéaire, pour chaque taille
     d'ensemble de ``sizes`` (``n_runs`` graines chacune)."""
-    bench = linear_benchmark() if bench is None else bench
-    return _convergence(
-        lambda b, N, g: ensemble_kalman_filter(b.nonlinear, b.y, b.x0, b.P0, n_members=N, rng=g),
-        sizes, n_runs, rng, bench, loglik=False,
-    )
+    return _cached_convergence(_ensemble_run, sizes, n_runs, rng, bench, loglik=False)
 
 
 @dataclass(frozen=True, eq=False)

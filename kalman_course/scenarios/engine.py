@@ -19,11 +19,14 @@ mesures (mV). Il est inversible sans être l'identité, ce qui sert à illustrer
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.linalg
 
 from ..core.models import LinearGaussianModel
 from ..core.simulation import Simulation, simulate
+from ..diagnostics.consistency import whitened_innovations
 from ..diagnostics.monte_carlo import ConsistencyRuns, MonteCarlo, monte_carlo, monte_carlo_consistency
 from ..filters.kalman import kalman_filter
 from ..lecture.estimator import MeanError, linear_estimator_runs, mean_error_recursion
@@ -42,6 +45,13 @@ __all__ = [
     "ENGINE_X0_MEAN",
     "engine_commands",
     "engine_model",
+    "engine_model_without_command",
+    "engine_simulation",
+    "engine_filter",
+    "engine_run",
+    "overconfident_run",
+    "ForgottenCommand",
+    "forgotten_command",
     "OVERCONFIDENT_P0",
     "MEAN_ERROR_RUNS",
     "MEAN_ERROR_STEPS",
@@ -108,6 +118,43 @@ def engine_commands(n_steps: int = 120) -> np.ndarray:
     return u.reshape(-1, 1)
 
 
+def engine_model_without_command() -> LinearGaussianModel:
+    r"""Le modèle du moteur qui « oublie » la commande : mêmes :math:`A`, :math:`C`, :math:`\Phi`,
+    :math:`\Psi`, sans matrice :math:`B` (l'hypothèse 1 du cours est violée)."""
+    model = engine_model()
+    return LinearGaussianModel(model.A, model.C, model.Q, model.R)
+
+
+# --------------------------------------------------------------------------- l'expérience du moteur
+
+
+def engine_simulation(n_steps: int = 120, *, true_model: LinearGaussianModel | None = None,
+                      rng=ENGINE_SEED) -> Simulation:
+    r"""Le moteur simulé pendant ``n_steps`` secondes : état initial vrai :data:`ENGINE_X0_MEAN` (moteur
+    froid), débit :func:`engine_commands`, bruits de ``true_model`` (par défaut :func:`engine_model`),
+    graine ``rng`` (par défaut celle du scénario)."""
+    model = engine_model() if true_model is None else true_model
+    return simulate(model, ENGINE_X0_MEAN, n_steps, engine_commands(n_steps), rng=rng)
+
+
+def engine_filter(filter_model: LinearGaussianModel, y, *, P0=ENGINE_P0) -> FilterResult:
+    r"""Les mesures ``y`` (T, 2) du moteur filtrées par ``filter_model`` depuis l'estimation initiale fausse
+    :data:`ENGINE_X0_HAT` et ``P0`` (par défaut :data:`ENGINE_P0`), avec le débit :func:`engine_commands`
+    (un modèle sans :math:`B`, :func:`engine_model_without_command`, n'en reçoit pas)."""
+    u = None if filter_model.B is None else engine_commands(len(y))
+    return kalman_filter(filter_model, y, ENGINE_X0_HAT, P0, u)
+
+
+def engine_run(n_steps: int = 120, *, true_model: LinearGaussianModel | None = None,
+               filter_model: LinearGaussianModel | None = None, P0=ENGINE_P0,
+               rng=ENGINE_SEED) -> tuple[Simulation, FilterResult]:
+    r"""L'expérience des chapitres linéaires : :func:`engine_simulation` puis :func:`engine_filter` (par
+    défaut avec le vrai modèle). Renvoie ``(simulation, FilterResult)``."""
+    sim = engine_simulation(n_steps, true_model=true_model, rng=rng)
+    model = (engine_model() if true_model is None else true_model) if filter_model is None else filter_model
+    return sim, engine_filter(model, sim.y, P0=P0)
+
+
 # --------------------------------------------------------------------------- « Construction d'un estimateur »
 
 #: Covariance initiale du filtre dans le chapitre de l'estimateur (°C²) : le filtre se croit précis à 1 °C
@@ -119,13 +166,16 @@ MEAN_ERROR_RUNS = 400
 MEAN_ERROR_STEPS = 60
 
 
+def overconfident_run(n_steps: int = MEAN_ERROR_STEPS) -> tuple[Simulation, FilterResult]:
+    """Le moteur simulé (graine 0) et filtré depuis ENGINE_X0_HAT avec OVERCONFIDENT_P0 : le filtre de
+    Kalman du chapitre de l'estimateur. Renvoie ``(simulation, FilterResult)``."""
+    return engine_run(n_steps, P0=OVERCONFIDENT_P0, rng=0)
+
+
 def engine_kalman_gains(n_steps: int = MEAN_ERROR_STEPS) -> np.ndarray:
     """Gains du filtre de Kalman du moteur (parti de ENGINE_X0_HAT, OVERCONFIDENT_P0), (T, 2, 2) : ils ne
     dépendent pas des mesures (une seule course suffit)."""
-    model = engine_model()
-    u = engine_commands(n_steps)
-    y = simulate(model, ENGINE_X0_MEAN, n_steps, u, rng=0).y
-    return kalman_filter(model, y, ENGINE_X0_HAT, OVERCONFIDENT_P0, u).K
+    return overconfident_run(n_steps)[1].K
 
 
 def mean_error_experiment(forget_command: bool, n_steps: int = MEAN_ERROR_STEPS,
@@ -165,10 +215,7 @@ def gain_limit_run(scale: float, n_steps: int = 120):
     Renvoie ``(simulation, FilterResult)``. :math:`s \to \infty` : :math:`K \to 0` ;
     :math:`s \to 0` : :math:`K \to C^{-1}` (ici :math:`C` est inversible sans être l'identité).
     """
-    u = engine_commands(n_steps)
-    sim = simulate(engine_model(), ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
-    result = kalman_filter(engine_model(Psi=scale * ENGINE_PSI), sim.y, ENGINE_X0_HAT, ENGINE_P0, u)
-    return sim, result
+    return engine_run(n_steps, filter_model=engine_model(Psi=scale * ENGINE_PSI))
 
 
 def gain_limit_sweep(scales=None, n_steps: int = 120):
@@ -214,11 +261,8 @@ def consistency_filters() -> dict[str, LinearGaussianModel]:
 def consistency_runs(n_steps: int = CONSISTENCY_STEPS) -> tuple[Simulation, dict[str, FilterResult]]:
     """Le moteur simulé une fois (modèle vrai, graine du scénario), filtré par chacun des filtres de
     :func:`consistency_filters` ; renvoie ``(simulation, {nom: FilterResult})``."""
-    true = engine_model()
-    u = engine_commands(n_steps)
-    sim = simulate(true, ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
-    results = {name: kalman_filter(m, sim.y, ENGINE_X0_HAT, ENGINE_P0, u) for name, m in consistency_filters().items()}
-    return sim, results
+    sim = engine_simulation(n_steps)
+    return sim, {name: engine_filter(m, sim.y) for name, m in consistency_filters().items()}
 
 
 def consistency_monte_carlo(n_runs: int = CONSISTENCY_MC_RUNS, n_steps: int = CONSISTENCY_MC_STEPS) -> dict[str, ConsistencyRuns]:
@@ -232,3 +276,33 @@ def consistency_monte_carlo(n_runs: int = CONSISTENCY_MC_RUNS, n_steps: int = CO
                                       rng=CONSISTENCY_MC_SEED, filter_model=filters[name], u=u)
         for name in ("modèle juste", "Ψ ÷ 10", "Φ × 10")
     }
+
+
+# --------------------------------------------------------------------------- « Implémentation pratique »
+
+
+@dataclass(frozen=True, eq=False)
+class ForgottenCommand:
+    r"""Le moteur filtré avec le bon modèle (``good``) et avec un modèle qui oublie la commande (``bad``,
+    :func:`engine_model_without_command`), sur la même ``simulation`` ; ``normalised_good`` et
+    ``normalised_bad`` (T,) : innovations normalisées du premier capteur,
+    :math:`\nu_{n,1}/\sqrt{S_{n,11}}` (première composante des innovations blanchies,
+    :func:`~kalman_course.whitened_innovations`)."""
+
+    simulation: Simulation
+    good: FilterResult
+    bad: FilterResult
+
+    @property
+    def normalised_good(self) -> np.ndarray:
+        return whitened_innovations(self.good)[:, 0]
+
+    @property
+    def normalised_bad(self) -> np.ndarray:
+        return whitened_innovations(self.bad)[:, 0]
+
+
+def forgotten_command(n_steps: int = 120) -> ForgottenCommand:
+    """Le moteur simulé une fois, filtré avec et sans la commande (chapitre « Implémentation pratique »)."""
+    sim = engine_simulation(n_steps)
+    return ForgottenCommand(sim, engine_filter(engine_model(), sim.y), engine_filter(engine_model_without_command(), sim.y))

@@ -15,10 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from ..core.simulation import Simulation, simulate
+from ..core.simulation import Simulation
 from ..core.validation import KalmanInputError, as_float_array
-from ..filters.kalman import kalman_filter
-from .engine import ENGINE_P0, ENGINE_PSI, ENGINE_SEED, ENGINE_X0_HAT, ENGINE_X0_MEAN, engine_commands, engine_model
+from .engine import ENGINE_P0, ENGINE_PSI, ENGINE_X0_HAT, engine_model, engine_run
 from .half_steps import HalfSteps, half_steps
 
 __all__ = ["CYCLE_STEPS", "EngineCycle", "engine_cycle"]
@@ -45,9 +44,7 @@ def engine_cycle(psi_scale: float = 1.0, n_steps: int = CYCLE_STEPS) -> EngineCy
     if s.ndim != 0 or not (np.isfinite(s) and s > 0):
         raise KalmanInputError(f"« psi_scale » doit être un facteur strictement positif ; reçu {psi_scale!r}.")
     model = engine_model()
-    u = engine_commands(n_steps)
-    sim = simulate(model, ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
     assumed = model if float(s) == 1.0 else engine_model(Psi=float(s) * ENGINE_PSI)
-    result = kalman_filter(assumed, sim.y, ENGINE_X0_HAT, ENGINE_P0, u)
+    sim, result = engine_run(n_steps, filter_model=assumed)
     inverted = scipy.linalg.solve(model.C, sim.y.T).T
     return EngineCycle(half_steps(result, ENGINE_X0_HAT, ENGINE_P0), sim, inverted, result.K)

@@ -18,9 +18,10 @@ import numpy as np
 from ..core.validation import KalmanInputError, as_float_array
 from ..filters.kalman import kalman_filter
 from ..lecture.estimator import covariance_for_gain
+from .engine import engine_model, engine_run
 from .voltage import constant_voltage_measurements, constant_voltage_model
 
-__all__ = ["TRACE_STEPS", "GainTrace", "gain_trace"]
+__all__ = ["TRACE_STEPS", "GainTrace", "gain_trace", "engine_trace_ratios"]
 
 #: Nombre de relevés du filtre de référence.
 TRACE_STEPS = 50
@@ -66,3 +67,24 @@ def gain_trace(n: int, K: float, n_steps: int = TRACE_STEPS) -> GainTrace:
         prediction_part=(1.0 - k) ** 2 * P_pred, measurement_part=k**2 * R,
         P_star=float(covariance_for_gain(model, [[P_pred]], [[K_star]])[0, 0]),
     )
+
+
+def engine_trace_ratios(n_directions: int = 6, step: int = 5, seed: int = 7) -> tuple[np.ndarray, np.ndarray]:
+    r"""Trace de :math:`P_{n}(K)` autour du gain de Kalman :math:`K^\star`, pour le moteur au pas ``step``
+    (:func:`~kalman_course.scenarios.engine.engine_run`).
+
+    Renvoie ``(t, ratios)`` : ``ratios[j, i]`` = :math:`\mathrm{tr}\,P(K^\star + t_i D_j)/\mathrm{tr}\,P(K^\star)`
+    pour des directions aléatoires :math:`D_j` (graine ``seed``) de norme :math:`\|K^\star\|`.
+    """
+    _, res = engine_run(step)
+    model = engine_model()
+    P_pred, K_star = res.P_pred[-1], res.K[-1]
+    rng = np.random.default_rng(seed)
+    t = np.linspace(-1.0, 1.0, 81)
+    base = np.trace(covariance_for_gain(model, P_pred, K_star))
+    ratios = []
+    for _ in range(n_directions):
+        D = rng.standard_normal(K_star.shape)
+        D *= np.linalg.norm(K_star) / np.linalg.norm(D)
+        ratios.append([np.trace(covariance_for_gain(model, P_pred, K_star + ti * D)) / base for ti in t])
+    return t, np.array(ratios)

@@ -50,8 +50,11 @@ POLAR_SEED = 11
 
 
 def polar_to_cartesian(x, u=None):
-    r""":math:`f(r, \theta) = (r\cos\theta,\ r\sin\theta)`."""
-    return np.array([x[0] * np.cos(x[1]), x[0] * np.sin(x[1])])
+    r""":math:`f(r, \theta) = (r\cos\theta,\ r\sin\theta)` (m) ; ``x`` (2,) ou pile (N, 2) ; ``u`` ignoré
+    (signature d'une transition :math:`f(x, u)`)."""
+    x = np.asarray(x, dtype=float)
+    r, theta = x[..., 0], x[..., 1]
+    return np.stack([r * np.cos(theta), r * np.sin(theta)], axis=-1)
 
 
 def polar_to_cartesian_jacobian(x, u=None):

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.results import FilterResult
-from ..core.simulation import Simulation, simulate
+from ..core.simulation import Simulation
 from ..core.validation import KalmanInputError, as_float_array
-from ..filters.kalman import kalman_filter
-from .engine import ENGINE_P0, ENGINE_PSI, ENGINE_SEED, ENGINE_X0_HAT, ENGINE_X0_MEAN, engine_commands, engine_model
+from ..diagnostics.consistency import whitened_innovations
+from .engine import ENGINE_PSI, engine_model, engine_run
 
 __all__ = ["SENSOR_STD", "TUNING_STEPS", "SensorTuning", "sensor_tuning"]
 
@@ -57,8 +57,7 @@ def sensor_tuning(true_std: float = SENSOR_STD, assumed_std: float = SENSOR_STD,
     r"""Le moteur simulé avec :math:`\sigma_{\text{vrai}}` = ``true_std`` et filtré avec
     :math:`\sigma_{\text{supposé}}` = ``assumed_std`` (°C)."""
     true_std, assumed_std = _std("true_std", true_std), _std("assumed_std", assumed_std)
-    u = engine_commands(n_steps)
-    sim = simulate(engine_model(Psi=_psi(true_std)), ENGINE_X0_MEAN, n_steps, u, rng=ENGINE_SEED)
-    result = kalman_filter(engine_model(Psi=_psi(assumed_std)), sim.y, ENGINE_X0_HAT, ENGINE_P0, u)
-    normalised = result.innovation[:, 0] / np.sqrt(result.S[:, 0, 0])
+    sim, result = engine_run(n_steps, true_model=engine_model(Psi=_psi(true_std)),
+                             filter_model=engine_model(Psi=_psi(assumed_std)))
+    normalised = whitened_innovations(result)[:, 0]
     return SensorTuning(sim, result, normalised, result.x[:, 0] - sim.x[:, 0], np.sqrt(result.P[:, 0, 0]))

@@ -17,6 +17,7 @@ Pour les curseurs du chapitre : :func:`tag_data` donne les données (fixes, grai
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -54,6 +55,8 @@ __all__ = [
     "run_tag_ekf",
     "run_tag_ukf",
     "position_rmse",
+    "TagComparison",
+    "tag_comparison",
     "rmse_grid",
     "rmse_table",
 ]
@@ -234,6 +237,41 @@ def position_rmse(x_est: Any, x_true: Any, skip: int = TAG_TRANSIENT_STEPS) -> f
     if e.shape[0] == 0:
         raise KalmanInputError(f"« skip » = {skip} ne laisse aucun pas pour l'erreur quadratique moyenne.")
     return float(np.sqrt(np.mean(np.sum(e**2, axis=1))))
+
+
+@dataclass(frozen=True, eq=False)
+class TagComparison:
+    r"""L'EKF et l'UKF du tag sur les mêmes mesures (réglages nominaux) : ``data``, ``ekf``, ``ukf`` ;
+    ``ekf_error``, ``ukf_error`` (T,) : erreurs de position :math:`\lVert\hat p_k - p_k\rVert` (m) ;
+    ``gap`` (T,) : écart :math:`\lVert\hat p^{\text{EKF}}_k - \hat p^{\text{UKF}}_k\rVert` (m) ;
+    ``ekf_rmse``, ``ukf_rmse`` : :func:`position_rmse` (m, régime transitoire exclu)."""
+
+    data: TagData
+    ekf: FilterResult
+    ukf: FilterResult
+    ekf_error: np.ndarray
+    ukf_error: np.ndarray
+    gap: np.ndarray
+    ekf_rmse: float
+    ukf_rmse: float
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "ekf_error", "ukf_error", "gap")
+
+
+@lru_cache(maxsize=1)
+def tag_comparison() -> TagComparison:
+    """L'EKF et l'UKF sur les données du tag (:func:`tag_data`) avec les réglages nominaux ; calculé une
+    fois par processus (le chapitre de l'UKF et sa figure le partagent ; le résultat est immuable)."""
+    data = tag_data()
+    ekf, ukf = run_tag_ekf(data=data), run_tag_ukf(data=data)
+    return TagComparison(
+        data, ekf, ukf,
+        ekf_error=np.linalg.norm(ekf.x[:, :2] - data.x_true[:, :2], axis=1),
+        ukf_error=np.linalg.norm(ukf.x[:, :2] - data.x_true[:, :2], axis=1),
+        gap=np.linalg.norm(ekf.x[:, :2] - ukf.x[:, :2], axis=1),
+        ekf_rmse=position_rmse(ekf.x, data.x_true), ukf_rmse=position_rmse(ukf.x, data.x_true),
+    )
 
 
 def rmse_grid(accel_stds: Any, range_stds: Any, data: TagData | None = None) -> np.ndarray:

@@ -1,55 +1,19 @@
 r"""Typographie française du livre, appliquée une fois pour toutes à la construction (extension Sphinx).
 
-Règles, sur le texte courant seulement (jamais dans le code, les formules, le HTML brut) :
-
-- espace insécable (U+00A0) avant « : » et à l'intérieur des guillemets « » ;
-- espace fine insécable (U+202F) avant « ; », « ! », « ? » et « % » ;
-- une seule apostrophe, la typographique « ’ » (U+2019).
-
-Les espaces ordinaires déjà présentes devant ces signes sont remplacées ; aucune espace n'est ajoutée
-devant un deux-points collé (« 10:30 », « http: »). Les guillemets reçoivent toujours leurs espaces.
+Les règles (espaces insécables avant « : ; ! ? % » et dans « », apostrophe « ’ ») sont celles de
+:mod:`kalman_course.typography` ; cette extension les applique au texte courant de chaque page, jamais
+dans le code, les formules ou le HTML brut.
 
 À déclarer dans ``_config.yml`` (``sphinx: extra_extensions``), avec ``smartquotes: false`` : les
 « guillemets intelligents » de docutils devinent mal l'apostrophe placée devant un mot en gras ou un
 lien (« l” » au lieu de « l’ ») ; ce module la traite à leur place, sans deviner.
-
-:func:`french_spacing` s'applique aussi à une chaîne Python (titres de figures Bokeh, légendes) ; les
-segments de formule ``$…$`` y sont laissés tels quels.
 """
 
 from __future__ import annotations
 
-import re
+from ..typography import apply_rules, french_spacing
 
-__all__ = ["NBSP", "NNBSP", "french_spacing", "setup"]
-
-#: Espace insécable (avant « : », dans « »).
-NBSP = "\u00a0"
-#: Espace fine insécable (avant « ; ! ? % »).
-NNBSP = "\u202f"
-
-_SPACES = "[ \t\r\n\u00a0\u202f]"
-_RULES = (
-    (re.compile(_SPACES + r"+:"), NBSP + ":"),
-    (re.compile(_SPACES + r"+([;!?%])"), NNBSP + r"\1"),
-    (re.compile("«" + _SPACES + "*"), "«" + NBSP),
-    (re.compile(_SPACES + "*»"), NBSP + "»"),
-    (re.compile("'"), "\u2019"),
-)
-_MATH = re.compile(r"(\$[^$]+\$)")
-
-
-def _apply(text: str) -> str:
-    for pattern, replacement in _RULES:
-        text = pattern.sub(replacement, text)
-    return text
-
-
-def french_spacing(text: str) -> str:
-    """``text`` avec les espaces insécables et l'apostrophe de la typographie française (voir le
-    module) ; les formules ``$…$`` ne sont pas modifiées."""
-    parts = _MATH.split(text)
-    return "".join(part if i % 2 else _apply(part) for i, part in enumerate(parts))
+__all__ = ["typeset", "setup"]
 
 
 # --------------------------------------------------------------------------- extension Sphinx
@@ -90,7 +54,7 @@ def typeset(document) -> int:
         if skip:
             continue
         old = str(node)
-        new = _apply(old)
+        new = apply_rules(old)
         if new != old:
             parent.replace(node, nodes.Text(new))
             changed += 1
@@ -130,7 +94,7 @@ def _check_smartquotes(app, config) -> None:
         from sphinx.errors import ConfigError
 
         raise ConfigError(
-            "kalman_course.book_typography traite lui-même apostrophes et guillemets : mettez "
+            "kalman_course.sphinx.typography traite lui-même apostrophes et guillemets : mettez "
             "« smartquotes: false » sous « sphinx: config: » dans _config.yml."
         )
 

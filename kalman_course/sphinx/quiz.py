@@ -1,6 +1,6 @@
 r"""Extension Sphinx du livre : la directive ``quiz``, questionnaires corrigés dans la page, hors ligne.
 
-À déclarer dans ``_config.yml`` (``sphinx: extra_extensions: [kalman_course.interactive.quiz]``). Dans un
+À déclarer dans ``_config.yml`` (``sphinx: extra_extensions: [kalman_course.sphinx.quiz]``). Dans un
 chapitre (MyST) :
 
 .. code-block:: markdown
