@@ -14,6 +14,7 @@ from . import nile, smoothing  # noqa: F401  (le Nil et le niveau local ; la cib
 from . import pendulum  # noqa: F401  (pendule : UKF, filtre particulaire)
 from . import banana, distant_target  # noqa: F401  (UKF : la « banane » polaire, la cible lointaine)
 from . import growth, convergence, importance  # noqa: F401  (filtre particulaire, EnKF : bimodal, convergence, poids)
+from . import labs  # noqa: F401  (travaux pratiques : le filtre de l'étudiant contre celui du paquet)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
@@ -23,6 +24,7 @@ __all__ = [
     "distant_target",
     "growth",
     "importance",
+    "labs",
     "diffuse",
     "nile",
     "smoothing",

@@ -1,0 +1,70 @@
+"""Le verdict du correcteur : réussi ou non, un texte en français, et son affichage dans Jupyter.
+
+Dans un carnet, le verdict s'affiche en encadré : vert (« ✔ Réussi ») ou rouge (« ✘ À corriger ») ;
+le symbole et le mot disent le résultat sans la couleur (lecteurs d'écran, daltonisme), les couleurs
+ont un contraste suffisant (RGAA / WCAG 2.1 AA). Le texte brut (console, ``print``) dit la même chose.
+"""
+
+from __future__ import annotations
+
+import html
+import re
+from dataclasses import dataclass
+
+__all__ = ["Verdict"]
+
+#: Couleurs de l'encadré : (bordure, fond, texte) ; contraste texte/fond > 10:1.
+_COLORS = {True: ("#1a7f37", "#e8f5ec", "#0b3318"), False: ("#b3261e", "#fdecea", "#5c1410")}
+
+
+def _inline(text: str) -> str:
+    """Texte → HTML : échappement, `code` en <code>."""
+    parts = re.split(r"`([^`]*)`", text)
+    out = []
+    for i, part in enumerate(parts):
+        escaped = html.escape(part)
+        out.append(f"<code>{escaped}</code>" if i % 2 else escaped)
+    return "".join(out)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Résultat de :func:`kalman_course.practice.check`.
+
+    ``passed`` : la fonction est juste sur tous les cas cachés ; ``feedback`` : l'explication en
+    français ; ``kind`` : « réussi », « pas écrite », « exception », « erreur classique », « forme »,
+    « valeur »… ; ``mistake`` : l'identifiant de l'erreur classique reconnue (ou ``None``) ; ``line`` : le
+    numéro de la ligne du code de l'étudiant en cause (ou ``None``).
+    """
+
+    exercise: str
+    title: str
+    passed: bool
+    feedback: str
+    kind: str
+    mistake: str | None = None
+    line: int | None = None
+
+    @property
+    def headline(self) -> str:
+        mark = "✔ Réussi" if self.passed else "✘ À corriger"
+        return f"{mark} — {self.title} ({self.exercise})"
+
+    def __str__(self) -> str:
+        return f"{self.headline}\n{self.feedback}"
+
+    def __repr__(self) -> str:
+        return str(self)
+
+    def _repr_html_(self) -> str:
+        border, background, color = _COLORS[self.passed]
+        paragraphs = "".join(f"<p style=\"margin:0.3em 0\">{_inline(p)}</p>"
+                             for p in self.feedback.split("\n") if p.strip())
+        css_class = "kc-verdict kc-verdict-" + ("reussi" if self.passed else "a-corriger")
+        return (
+            f'<div class="{css_class}" role="status" style="border-left:6px solid {border};'
+            f"background:{background};color:{color};padding:0.5em 1em;margin:0.5em 0;"
+            f'border-radius:4px;line-height:1.45">'
+            f'<p style="margin:0.2em 0;font-weight:bold">{html.escape(self.headline)}</p>'
+            f"{paragraphs}</div>"
+        )
