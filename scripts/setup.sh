@@ -15,10 +15,12 @@ cd "$(dirname "$0")/.."
 log() { printf '[setup] %s\n' "$*" >&2; }
 
 want_pdf=0
+python_only=0   # --python-only : .venv seulement (scripts/lab.sh : ni Chromium, ni npm, ni ressources web)
 for arg in "$@"; do
   case "$arg" in
     --pdf) want_pdf=1 ;;
-    *) log "ERREUR : option inconnue « $arg » (seule option : --pdf)"; exit 2 ;;
+    --python-only) python_only=1 ;;
+    *) log "ERREUR : option inconnue « $arg » (options : --pdf, --python-only)"; exit 2 ;;
   esac
 done
 
@@ -42,7 +44,7 @@ apt_install() {
 }
 
 # --- Chromium (Debian) --------------------------------------------------------------------------
-if [ ! -x /usr/bin/chromium ]; then
+if [ "$python_only" = 0 ] && [ ! -x /usr/bin/chromium ]; then
   apt_install "Chromium" chromium
 fi
 
@@ -137,6 +139,8 @@ fi
 mkdir -p .venv/etc/ipython
 cmp -s scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.py \
   || cp scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.py
+
+[ "$python_only" = 1 ] && exit 0
 
 # --- npm ----------------------------------------------------------------------------------------
 stamp_npm=node_modules/.lock.sha
