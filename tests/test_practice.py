@@ -658,6 +658,14 @@ def test_lab_script_opens_jupyterlab_offline_on_the_lab_notebooks(tmp_path):
             shutil.rmtree(work, ignore_errors=True)
 
 
+def test_binder_opens_the_lab_notebooks_with_the_pinned_jupyterlab():
+    post = (ROOT / "binder" / "postBuild").read_text()
+    folder = re.search(r'default_url = "/lab/tree/([^"]+)"', post).group(1)
+    assert sorted(p.stem for p in (ROOT / folder).glob("*.ipynb")) == LAB_PAGES
+    assert "-r ../requirements.txt" in (ROOT / "binder" / "requirements.txt").read_text()
+    assert re.search(r"(?m)^jupyterlab==\d", (ROOT / "requirements.txt").read_text())
+
+
 # --------------------------------------------------------------------------- livre construit
 
 
