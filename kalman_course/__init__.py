@@ -262,13 +262,14 @@ __all__ = [
     "numbers",
     "scenarios",
     "interactive",
+    "practice",
 ]
 
 __version__ = "0.1.0"
 
 
 #: Sous-modules chargés à la première utilisation (voir l'en-tête).
-_LAZY_SUBMODULES = ("figures", "scenarios", "interactive", "numbers", "datasets")
+_LAZY_SUBMODULES = ("figures", "scenarios", "interactive", "numbers", "datasets", "practice")
 
 
 def __getattr__(name: str):

@@ -71,17 +71,17 @@ def _sigma_judge(outs, case) -> str | None:
         return "Le premier point sigma doit être la moyenne : χ₀ = x."
     if not close(wm, ref_wm):
         lam = case.info["lam"]
-        return (f"Poids de la moyenne faux : W⁰ₘ = λ/(n + λ) et Wⁱₘ = 1/(2(n + λ)), avec "
+        return (f"Poids de la moyenne faux : wm₀ = λ/(n + λ) et wmᵢ = 1/(2(n + λ)), avec "
                 f"λ = α²(n + κ) − n (ici λ = {_fr(lam)}).")
     if not close(wc, ref_wc):
-        return "Poids de la covariance faux : W⁰꜀ = W⁰ₘ + (1 − α² + β), les autres égaux à ceux de la moyenne."
+        return "Poids de la covariance faux : wc₀ = wm₀ + (1 − α² + β), les autres égaux à ceux de la moyenne."
     plus, minus = chi[1:n + 1] - x, chi[n + 1:] - x
     if not close(plus, -minus):
         return ("Les points doivent aller par paires symétriques : χᵢ = x + sᵢ et χₙ₊ᵢ = x − sᵢ (même ordre "
                 "dans les deux moitiés).")
     cov = (wc[:, None, None] * np.einsum("ki,kj->kij", chi - x, chi - x)).sum(axis=0)
     if not close(cov, P):
-        return ("Les points ne restituent pas la covariance : Σ W꜀ⁱ (χᵢ − x)(χᵢ − x)ᵀ doit valoir P. Les écarts "
+        return ("Les points ne restituent pas la covariance : Σ wcᵢ (χᵢ − x)(χᵢ − x)ᵀ doit valoir P. Les écarts "
                 "sᵢ sont les colonnes d'une racine carrée S de (n + λ) P (S Sᵀ = (n + λ) P).")
     return None
 
@@ -200,7 +200,7 @@ SIGMA_POINTS = Exercise(
     shapes_hint="x (n,), P (n, n) ; chi (2n + 1, n), une ligne par point ; wm, wc (2n + 1,)",
     mistakes=(
         Mistake("wc-equals-wm", "poids de covariance sans le terme (1 − α² + β)",
-                "Le poids central de la covariance est W⁰꜀ = λ/(n + λ) + (1 − α² + β) : ce terme (β = 2 est "
+                "Le poids central de la covariance est wc₀ = λ/(n + λ) + (1 − α² + β) : ce terme (β = 2 est "
                 "optimal pour une loi gaussienne) corrige le quatrième moment. Les autres poids sont communs.",
                 _sigma_wc_equals_wm, detect=_detect_wc_equals_wm, culprit=(r"\bwc\w*\s*(\[\s*0\s*\])?\s*=",)),
         Mistake("no-scale", "racine de P au lieu de racine de (n + λ) P",
@@ -317,15 +317,15 @@ UNSCENTED_TRANSFORM = Exercise(
     shapes_hint="chi (2n + 1, n), wm, wc (2n + 1,), f(chi[i]) (m,) ; mean (m,), cov (m, m)",
     mistakes=(
         Mistake("cov-with-wm", "covariance pondérée par wm au lieu de wc",
-                "La moyenne utilise les poids W_m, la covariance les poids W_c : ils diffèrent au point central "
-                "de (1 − α² + β). Avec W_m partout, la covariance est fausse (trop petite pour β = 2).",
+                "La moyenne utilise les poids wm, la covariance les poids wc : ils diffèrent au point central "
+                "de (1 − α² + β). Avec wm partout, la covariance est fausse (trop petite pour β = 2).",
                 _ut_cov_with_wm, outputs=(1,), output=1),
         Mistake("f-of-mean", "f de la moyenne au lieu de la moyenne des images",
-                "La transformée sans parfum moyenne les images : ȳ = Σ W_mⁱ f(χᵢ). f(x̄) est la prédiction "
+                "La transformée sans parfum moyenne les images : ȳ = Σ wmᵢ f(χᵢ). f(x̄) est la prédiction "
                 "linéarisée (celle de l'EKF), que la transformée cherche justement à corriger.",
                 _ut_f_of_mean, outputs=(0,), output=0),
         Mistake("not-centred", "covariance sans retrancher la moyenne",
-                "P_y = Σ W_cⁱ (f(χᵢ) − ȳ)(f(χᵢ) − ȳ)ᵀ : il faut centrer les images ; Σ W_cⁱ f(χᵢ) f(χᵢ)ᵀ est un "
+                "P_y = Σ wcᵢ (f(χᵢ) − ȳ)(f(χᵢ) − ȳ)ᵀ : il faut centrer les images ; Σ wcᵢ f(χᵢ) f(χᵢ)ᵀ est un "
                 "moment d'ordre deux, pas une covariance.",
                 _ut_not_centred, outputs=(1,), output=1),
         Mistake("uniform-weights", "poids égaux 1/(2n + 1)",

@@ -17,13 +17,20 @@ __all__ = ["Verdict"]
 _COLORS = {True: ("#1a7f37", "#e8f5ec", "#0b3318"), False: ("#b3261e", "#fdecea", "#5c1410")}
 
 
+def _french(text: str) -> str:
+    """La typographie française (espaces insécables, apostrophe « ’ ») hors des `extraits de code`."""
+    from ..book_typography import french_spacing
+
+    parts = re.split(r"(`[^`]*`)", text)
+    return "".join(part if i % 2 else french_spacing(part) for i, part in enumerate(parts))
+
+
 def _inline(text: str) -> str:
-    """Texte → HTML : échappement, `code` en <code>."""
+    """Texte → HTML : typographie française, échappement, `code` en <code>."""
     parts = re.split(r"`([^`]*)`", text)
     out = []
     for i, part in enumerate(parts):
-        escaped = html.escape(part)
-        out.append(f"<code>{escaped}</code>" if i % 2 else escaped)
+        out.append(f"<code>{html.escape(part)}</code>" if i % 2 else html.escape(_french(part)))
     return "".join(out)
 
 
@@ -32,7 +39,7 @@ class Verdict:
     """Résultat de :func:`kalman_course.practice.check`.
 
     ``passed`` : la fonction est juste sur tous les cas cachés ; ``feedback`` : l'explication en
-    français ; ``kind`` : « réussi », « pas écrite », « exception », « erreur classique », « forme »,
+    français (texte brut ; l'affichage, ``str`` et HTML, y met la typographie française) ; ``kind`` : « réussi », « pas écrite », « exception », « erreur classique », « forme »,
     « valeur »… ; ``mistake`` : l'identifiant de l'erreur classique reconnue (ou ``None``) ; ``line`` : le
     numéro de la ligne du code de l'étudiant en cause (ou ``None``).
     """
@@ -51,7 +58,7 @@ class Verdict:
         return f"{mark} — {self.title} ({self.exercise})"
 
     def __str__(self) -> str:
-        return f"{self.headline}\n{self.feedback}"
+        return _french(f"{self.headline}\n{self.feedback}")
 
     def __repr__(self) -> str:
         return str(self)
@@ -65,6 +72,6 @@ class Verdict:
             f'<div class="{css_class}" role="status" style="border-left:6px solid {border};'
             f"background:{background};color:{color};padding:0.5em 1em;margin:0.5em 0;"
             f'border-radius:4px;line-height:1.45">'
-            f'<p style="margin:0.2em 0;font-weight:bold">{html.escape(self.headline)}</p>'
+            f'<p style="margin:0.2em 0;font-weight:bold">{html.escape(_french(self.headline))}</p>'
             f"{paragraphs}</div>"
         )
