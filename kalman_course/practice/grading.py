@@ -325,7 +325,6 @@ def _mistake_place(mistake: Mistake, source: StudentSource | None, k: int) -> Pl
 def _judge(ex: Exercise, fn: Callable, source: StudentSource | None, names: list[str]) -> Verdict:
     k = len(ex.outputs)
     cases = ex.cases()
-    first_outputs = None
     for number, case in enumerate(cases, 1):
         args = tuple(copy.deepcopy(a) for a in case.args)
         outcome: Outcome = call(fn, args)
@@ -355,8 +354,16 @@ def _judge(ex: Exercise, fn: Callable, source: StudentSource | None, names: list
                                   f"nouvelle variable (`{name}_new = {name} + …`) ou sur `{name}.copy()`.",
                                   place, case=(number, case)))
         outs = _outputs(ex, outcome.value, source)
-        if first_outputs is None:
-            first_outputs = outs
+        if ex.deterministic and number == 1:  # même appel, même résultat : pas de hasard caché
+            again = call(fn, tuple(copy.deepcopy(a) for a in case.args))
+            try:
+                same = again.ok and all(close(a, b, rtol=1e-12) for a, b in zip(_outputs(ex, again.value, source), outs))
+            except _Stop:
+                same = False
+            if not same:
+                raise _Stop(_fail(ex, "valeur", "Deux appels avec les mêmes arguments donnent deux résultats "
+                                  "différents : n'utilisez pas de tirage aléatoire ni de variable globale modifiée "
+                                  "(ici, tout le hasard est dans les arguments).", None, case=(number, case)))
         if ex.judge is not None:
             message = ex.judge(outs, case)
             correct = message is None
@@ -378,17 +385,6 @@ def _judge(ex: Exercise, fn: Callable, source: StudentSource | None, names: list
             raise _Stop(_fail(ex, "valeur", message, source.return_place() if source is not None else None,
                               case=(number, case)))
         raise _Stop(_value_problem(ex, outs, case, source, number))
-    if ex.deterministic and cases:
-        again = call(fn, tuple(copy.deepcopy(a) for a in cases[0].args))
-        if again.ok:
-            try:
-                same = all(close(a, b, rtol=1e-12) for a, b in zip(_outputs(ex, again.value, source), first_outputs))
-            except _Stop:
-                same = False
-            if not same:
-                raise _Stop(_fail(ex, "valeur", "Deux appels avec les mêmes arguments donnent deux résultats "
-                                  "différents : n'utilisez pas de tirage aléatoire ni de variable globale modifiée "
-                                  "(ici, tout le hasard est dans les arguments).", None))
     labels = "\n".join(f"- {c.label}" for c in cases)
     return Verdict(ex.id, ex.title, True,
                    f"Bravo : votre fonction donne le bon résultat sur les {len(cases)} cas cachés :\n{labels}",

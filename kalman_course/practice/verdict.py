@@ -65,8 +65,17 @@ class Verdict:
 
     def _repr_html_(self) -> str:
         border, background, color = _COLORS[self.passed]
-        paragraphs = "".join(f"<p style=\"margin:0.3em 0\">{_inline(p)}</p>"
-                             for p in self.feedback.split("\n") if p.strip())
+        blocks, items = [], []
+        for line in [p for p in self.feedback.split("\n") if p.strip()] + [""]:
+            if line.startswith("- "):
+                items.append(f"<li>{_inline(line[2:])}</li>")
+                continue
+            if items:  # une liste (les cas cachés réussis)
+                blocks.append(f'<ul style="margin:0.2em 0 0.2em 1.2em;padding:0">{"".join(items)}</ul>')
+                items = []
+            if line:
+                blocks.append(f'<p style="margin:0.3em 0">{_inline(line)}</p>')
+        paragraphs = "".join(blocks)
         css_class = "kc-verdict kc-verdict-" + ("reussi" if self.passed else "a-corriger")
         return (
             f'<div class="{css_class}" role="status" style="border-left:6px solid {border};'
