@@ -681,7 +681,7 @@ def test_built_lab_page_ran_its_solutions_and_offers_the_student_notebook(built_
     html = (built_book / "book" / f"{page}.html").read_text()
     checks = len(re.findall(r"^practice\.check\(", _page(page), re.M))
     assert html.count('class="kc-verdict kc-verdict-reussi"') == checks
-    assert "kc-verdict-a-corriger" not in html and "pas encore écrite" not in html
+    assert "kc-verdict-a-corriger" not in html and "Fonction pas encore écrite" not in html
     assert "Votre filtre n&#39;a pas pu tourner" not in html and "Votre filtre n'a pas pu tourner" not in html
     link = re.search(rf'href="(\.\./_downloads/[0-9a-f]+/{page}\.ipynb)"', html)
     assert link, f"{page} : pas de lien de téléchargement du carnet"
