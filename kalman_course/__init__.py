@@ -252,13 +252,14 @@ __all__ = [
     "scenarios",
     "interactive",
     "datasets",
+    "practice",
 ]
 
 __version__ = "0.1.0"
 
 
 #: Sous-modules chargés à la première utilisation (voir l'en-tête).
-_LAZY_SUBMODULES = ("figures", "scenarios", "interactive", "numbers", "datasets")
+_LAZY_SUBMODULES = ("figures", "scenarios", "interactive", "numbers", "datasets", "practice")
 
 
 def __getattr__(name: str):

@@ -15,10 +15,12 @@ cd "$(dirname "$0")/.."
 log() { printf '[setup] %s\n' "$*" >&2; }
 
 want_pdf=0
+python_only=0   # --python-only : .venv seulement (scripts/lab.sh : ni Chromium, ni npm, ni ressources web)
 for arg in "$@"; do
   case "$arg" in
     --pdf) want_pdf=1 ;;
-    *) log "ERREUR : option inconnue « $arg » (seule option : --pdf)"; exit 2 ;;
+    --python-only) python_only=1 ;;
+    *) log "ERREUR : option inconnue « $arg » (options : --pdf, --python-only)"; exit 2 ;;
   esac
 done
 
@@ -42,7 +44,7 @@ apt_install() {
 }
 
 # --- Chromium (Debian) --------------------------------------------------------------------------
-if [ ! -x /usr/bin/chromium ]; then
+if [ "$python_only" = 0 ] && [ ! -x /usr/bin/chromium ]; then
   apt_install "Chromium" chromium
 fi
 
@@ -68,7 +70,7 @@ stamp_npm=node_modules/.lock.sha
 want_npm=$(sha256sum package-lock.json | cut -d' ' -f1)
 npm_pid=""
 npm_log=""
-if [ ! -f "$stamp_npm" ] || [ "$(cat "$stamp_npm")" != "$want_npm" ]; then
+if [ "$python_only" = 0 ] && { [ ! -f "$stamp_npm" ] || [ "$(cat "$stamp_npm")" != "$want_npm" ]; }; then
   log "installation des ressources npm (npm ci), en parallèle des dépendances Python…"
   npm_log=$(mktemp)
   (PUPPETEER_SKIP_DOWNLOAD=true npm ci --no-audit --no-fund --loglevel=error --prefer-offline >"$npm_log" 2>&1) &
@@ -165,6 +167,8 @@ cmp -s scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.
 
 # --- npm : fin --------------------------------------------------------------------------------
 wait_npm
+
+[ "$python_only" = 1 ] && exit 0
 
 # --- ressources web locales ---------------------------------------------------------------------
 .venv/bin/python scripts/vendor_assets.py

@@ -29,6 +29,9 @@ LINEAR_CHAPTERS = [
 ]
 # Annexes : pages sans figure ni exercice.
 APPENDICES = {"references", "errata"}
+# Travaux pratiques : l'étudiant écrit les fonctions ; la solution (repliée) est son code, vérifié par
+# practice.check à la construction.
+PRACTICAL_WORK = {Path(f).stem for f in (ROOT / "book").glob("tp-*.md")}
 # Tous les chapitres du livre (hors introduction et annexes), tels que _toc.yml les liste.
 ALL_CHAPTERS = [
     Path(f).name
@@ -68,7 +71,7 @@ def test_chapters_hold_no_plotting_code_and_draw_registered_figures(chapter):
     code = "\n".join(_code_cells(text))
     for forbidden in ("matplotlib", "pyplot", ".plot(", ".scatter(", ".hist(", "savefig", "set_xlabel"):
         assert forbidden not in code, f"{chapter} : code de tracé « {forbidden} » dans une cellule"
-    drawn = re.findall(r"kc\.figures\.draw\(\"([^\"]+)\"\)", code)
+    drawn = re.findall(r"kc\.figures\.draw\(\"([^\"]+)\"[,)]", code)  # TP : draw("nom", predict=predict)
     assert drawn, f"{chapter} : aucune figure"
     for name in drawn:
         assert name in kc.figures.REGISTRY, f"{chapter} : figure inconnue {name}"
@@ -85,7 +88,14 @@ def test_each_chapter_has_an_exercise_with_a_hidden_computed_solution(chapter):
         block = re.search(r"```\{solution-start\} " + re.escape(label) + r"\n(.*?)```\{solution-end\}", text, re.S)
         assert block, f"{chapter} : pas de solution pour {label}"
         assert ":class: dropdown" in block.group(1)
-        assert "kc." in "".join(_code_cells(block.group(1) + "```")), f"{label} : la solution n'appelle pas le paquet"
+        if chapter in PRACTICAL_WORK:
+            # TP : la solution est le code de l'étudiant (numpy seul) ; c'est la cellule practice.check
+            # qui suit le bloc, exécutée à la construction, qui la vérifie contre le paquet.
+            after = text[block.end():]
+            assert re.match(r"[^\n]*\n```\s*```\{code-cell\}[^\n]*\npractice\.check\(", after), \
+                f"{label} : la solution du TP n'est pas suivie de sa vérification practice.check(...)"
+        else:
+            assert "kc." in "".join(_code_cells(block.group(1) + "```")), f"{label} : la solution n'appelle pas le paquet"
 
 
 def test_figure_registry_knows_every_chapter_title():
@@ -308,7 +318,7 @@ def _cells_with_metadata(text: str) -> list[tuple[dict, str]]:
 @pytest.mark.parametrize("chapter", ALL_CHAPTERS)
 def test_every_figure_has_a_caption_a_name_and_an_alt_text(chapter):
     for meta, body in _cells_with_metadata((BOOK / f"{chapter}.md").read_text()):
-        drawn = re.findall(r'kc\.figures\.draw\("([^"]+)"\)', body)
+        drawn = re.findall(r'kc\.figures\.draw\("([^"]+)"[,)]', body)
         if not drawn:
             continue
         figure = meta.get("mystnb", {}).get("figure", {})

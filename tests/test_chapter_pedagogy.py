@@ -20,6 +20,10 @@ BOOK = ROOT / "book"
 
 #: Annexes du livre (ni objectifs, ni figure à curseurs, ni quiz).
 APPENDICES = {"references", "errata"}
+#: Travaux dirigés (papier et crayon) et travaux pratiques (l'étudiant écrit le code, le correcteur
+#: répond) : pas de figure à curseurs — l'interactivité d'un TD est le calcul à la main, celle d'un TP le
+#: code de l'étudiant et le verdict de practice.check. Objectifs, « À retenir » et quiz restent exigés.
+PRACTICE_PAGES = {p.stem for p in (Path(__file__).resolve().parent.parent / "book").glob("t[dp]-*.md")}
 
 
 def _pages() -> list[str]:
@@ -117,7 +121,7 @@ _LIVE = {"tension-curseurs": "live_voltage_explorer()", "tag-curseurs": "live_ta
          "nil-curseurs": "live_nile_explorer()"}
 
 
-@pytest.mark.parametrize("page", PAGES)
+@pytest.mark.parametrize("page", [p for p in PAGES if p not in PRACTICE_PAGES])
 def test_page_shows_its_slider_figures_each_with_an_observation_box_and_live_code(page):
     text = _text(page)
     cells = re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, re.S)

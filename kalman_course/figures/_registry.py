@@ -34,6 +34,13 @@ CHAPTER_TITLES: dict[str, str] = {
     "vraisemblance": "Apprendre Q et R : vraisemblance et données réelles",
     "srif": "Filtre d'information en racine carrée (SRIF)",
     "ekf-itere-se3": "EKF itéré sur SE(3) : pose d'une cible vue par une caméra",
+    "tp-filtre-lineaire": "TP 1 — Le filtre de Kalman linéaire : la tension constante",
+    "tp-ekf-tag": "TP 2 — Le filtre de Kalman étendu : suivre le tag radio",
+    "tp-ukf-particulaire": "TP 3 — UKF et filtre particulaire : le pendule",
+    "tp-lissage-em": "TP 4 — Lisser et apprendre : le Nil",
+    "td-filtre-lineaire": "TD 1 — Le gain de Kalman à la main",
+    "td-filtres-a-points": "TD 2 — Filtres à points : calculs à la main",
+    "td-lissage-em": "TD 3 — Lissage et EM à la main",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).
@@ -95,8 +102,12 @@ def names() -> list[str]:
     return list(REGISTRY)
 
 
-def draw(name: str) -> Figure:
+def draw(name: str, **inputs) -> Figure:
     """Construit la figure ``name`` (une nouvelle ``matplotlib.figure.Figure``, sans état global pyplot).
+
+    ``inputs`` : ce que la figure accepte en plus (les figures des travaux pratiques prennent les
+    fonctions de l'étudiant, ``draw("tp-tension", predict=predict, update=update)``) ; sans eux, chaque
+    figure se dessine seule, à graine fixe.
 
     Graduations (virgule décimale, puissances de dix) et textes (espaces insécables) sont mis à la
     française par :func:`kalman_course.numbers.french_figure` : une seule fois ici, pour toutes les figures."""
@@ -106,7 +117,7 @@ def draw(name: str) -> Figure:
         raise KalmanInputError(
             f"Figure inconnue « {name} ». Figures disponibles : {', '.join(REGISTRY)}."
         ) from None
-    figure = spec.build()
+    figure = spec.build(**inputs)
     french_figure(figure)
     return figure
 

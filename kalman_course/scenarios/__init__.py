@@ -15,6 +15,8 @@ from . import nile, smoothing  # noqa: F401  (le Nil et le niveau local ; la cib
 from . import pendulum  # noqa: F401  (pendule : UKF, filtre particulaire)
 from . import banana, distant_target  # noqa: F401  (UKF : la « banane » polaire, la cible lointaine)
 from . import growth, convergence, importance  # noqa: F401  (filtre particulaire, EnKF : bimodal, convergence, poids)
+from . import labs  # noqa: F401  (travaux pratiques : le filtre de l'étudiant contre celui du paquet)
+from . import tutorials  # noqa: F401  (travaux dirigés : les exemples calculés à la main)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
@@ -24,6 +26,8 @@ __all__ = [
     "distant_target",
     "growth",
     "importance",
+    "labs",
+    "tutorials",
     "diffuse",
     "nile",
     "smoothing",

@@ -1,0 +1,134 @@
+"""Figures des travaux pratiques : le filtre de l'étudiant contre celui du paquet.
+
+Chaque figure prend les fonctions de l'étudiant en arguments nommés
+(``kc.figures.draw("tp-tension", predict=predict, update=update)``) ; sans argument, elle trace les
+solutions de référence du correcteur. Si le code de l'étudiant échoue (fonction pas encore écrite,
+exception), la figure montre le seul filtre du paquet et dit pourquoi dans son titre.
+"""
+
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+
+from ..scenarios.labs import nile_lab, pendulum_lab, tag_lab, voltage_lab
+from ._registry import new_figure, register
+from .likelihood import _year_formatter
+
+YOURS = "tab:orange"
+PACKAGE = "tab:blue"
+
+
+def _note(fig, message: str | None) -> None:
+    """Le message d'échec du code de l'étudiant, en tête de figure (sinon rien)."""
+    if message:
+        text = "\n".join(textwrap.wrap(f"Votre filtre n'a pas pu tourner : {message}.", 110))
+        fig.suptitle(text, fontsize=8, color="#8a1c13", ha="left", x=0.01)
+
+
+@register("tp-tension", chapter="tp-filtre-lineaire",
+          title="TP 1 : votre filtre et celui du paquet sur la tension constante")
+def voltage_lab_figure(predict=None, update=None):
+    run = voltage_lab(predict, update)
+    n = run.data["n"]
+    fig, (ax, az) = new_figure(2, 1, width=7.0, height=5.6, sharex=True)
+    ax.axhline(run.data["true"], color="tab:green", lw=1.2, label="valeur vraie")
+    ax.plot(n, run.data["z"], "+", color="0.45", ms=6, label="mesures $y_n$")
+    ax.plot(n, run.reference["x"], color=PACKAGE, lw=2.0, label="paquet : kc.kalman_filter")
+    az.plot(n, run.reference["P"], color=PACKAGE, lw=2.0, label="paquet")
+    if run.student is not None:
+        ax.plot(n, run.student["x"], "o", ms=3.5, mfc="none", color=YOURS, label="votre filtre")
+        az.plot(n, run.student["P"], "o", ms=3.5, mfc="none", color=YOURS, label="votre filtre")
+    ax.set_ylabel("tension (V)")
+    ax.set_title(r"Estimation $\hat x_n$ : vos points doivent tomber sur la courbe du paquet", fontsize=10)
+    ax.legend(loc="lower right", fontsize=8)
+    az.set_yscale("log")
+    az.set_ylabel(r"variance $P_n$ (V²)")
+    az.set_xlabel("itération n (sans unité)")
+    az.legend(loc="upper right", fontsize=8)
+    for a in (ax, az):
+        a.grid(alpha=0.3)
+    _note(fig, run.message)
+    return fig
+
+
+@register("tp-tag", chapter="tp-ekf-tag", title="TP 2 : votre EKF et celui du paquet sur le tag radio")
+def tag_lab_figure(update=None, ranges_jacobian=None):
+    run = tag_lab(update, ranges_jacobian)
+    true, anchors, t = run.data["true"], run.data["anchors"], run.data["t"]
+    fig, (ax, az) = new_figure(1, 2, width=8.0, height=3.8)
+    ax.plot(true[:, 0], true[:, 1], color="tab:green", lw=1.2, label="trajectoire vraie")
+    ax.plot(anchors[:, 0], anchors[:, 1], "^", color="k", ms=7, label="ancres")
+    ax.plot(run.reference["x"][:, 0], run.reference["x"][:, 1], color=PACKAGE, lw=1.5, label="paquet")
+    err_ref = np.linalg.norm(run.reference["x"][:, :2] - true[:, :2], axis=1)
+    az.plot(t, err_ref, color=PACKAGE, lw=1.5, label="paquet")
+    if run.student is not None:
+        x = run.student["x"]
+        ax.plot(x[:, 0], x[:, 1], "--", color=YOURS, lw=1.5, label="votre EKF")
+        az.plot(t, np.linalg.norm(x[:, :2] - true[:, :2], axis=1), "--", color=YOURS, lw=1.5, label="votre EKF")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal")
+    ax.set_title("Trajectoires estimées", fontsize=10)
+    ax.legend(loc="upper center", fontsize=7, ncol=2)
+    az.set_yscale("log")
+    az.set_xlabel("temps (s)")
+    az.set_ylabel("erreur de position (m)")
+    az.set_title("Erreur de position", fontsize=10)
+    az.legend(loc="upper right", fontsize=8)
+    for a in (ax, az):
+        a.grid(alpha=0.3)
+    _note(fig, run.message)
+    return fig
+
+
+@register("tp-pendule", chapter="tp-ukf-particulaire",
+          title="TP 3 : votre UKF et votre filtre particulaire contre ceux du paquet (pendule)")
+def pendulum_lab_figure(sigma_points=None, unscented_transform=None, systematic_resample=None,
+                        particle_weights=None):
+    run = pendulum_lab(sigma_points, unscented_transform, systematic_resample, particle_weights)
+    t, true = run.data["t"], run.data["true"]
+    fig, axes = new_figure(2, 1, width=7.0, height=5.6, sharex=True, sharey=True)
+    for ax, key, name in ((axes[0], "ukf", "UKF"), (axes[1], "pf", "filtre particulaire")):
+        ax.plot(t, true[:, 0], color="tab:green", lw=1.2, label="angle vrai")
+        ax.plot(t, run.reference[key][:, 0], color=PACKAGE, lw=2.0, label=f"{name} du paquet")
+        if run.student[key] is not None:
+            ax.plot(t, run.student[key][:, 0], "--", color=YOURS, lw=1.5, label=f"votre {name}")
+        ax.set_ylabel(r"angle $\theta$ (rad)")
+        ax.legend(loc="lower left", fontsize=8, ncol=3)
+        ax.grid(alpha=0.3)
+    axes[0].set_title("UKF : mêmes points sigma, mêmes résultats (à l'arrondi près)", fontsize=10)
+    axes[1].set_title("Filtre particulaire : mêmes lois, tirages différents, résultats proches", fontsize=10)
+    axes[1].set_xlabel("temps (s)")
+    _note(fig, run.message)
+    return fig
+
+
+@register("tp-nil", chapter="tp-lissage-em", title="TP 4 : votre lisseur et votre EM contre ceux du paquet (Nil)")
+def nile_lab_figure(rts_step=None, m_step=None):
+    run = nile_lab(rts_step, m_step)
+    year, y = run.data["year"], run.data["y"]
+    fig, (ax, az) = new_figure(2, 1, width=7.0, height=6.0)
+    ax.plot(year, y, ".", color="0.45", ms=4, label="débit mesuré")
+    ax.plot(year, run.reference["smoothed"], color=PACKAGE, lw=2.0, label="niveau lissé (paquet)")
+    if run.student["smoothed"] is not None:
+        ax.plot(year, run.student["smoothed"], "--", color=YOURS, lw=1.5, label="votre lisseur")
+    ax.set_xlabel("temps (année)")
+    ax.xaxis.set_major_formatter(_year_formatter())
+    ax.set_ylabel("débit annuel (10⁸ m³)")
+    ax.legend(loc="upper right", fontsize=8)
+    it = np.arange(run.reference["variances"].shape[0])
+    for j, (name, style) in enumerate(((r"$\sigma^2_\varepsilon$", "-"), (r"$\sigma^2_\eta$", ":"))):
+        az.plot(it, run.reference["variances"][:, j], style, color=PACKAGE, lw=2.0, label=f"{name}, EM du paquet")
+        if run.student["variances"] is not None:
+            az.plot(it, run.student["variances"][:, j], "o", ms=3.5, mfc="none", color=YOURS,
+                    label=f"{name}, votre étape M")
+    az.set_yscale("log")
+    az.set_xlabel("itération d'EM")
+    az.set_ylabel("variance (10¹⁶ m⁶)")
+    az.legend(loc="center right", fontsize=8)
+    for a in (ax, az):
+        a.grid(alpha=0.3)
+    _note(fig, run.message)
+    return fig

@@ -1,0 +1,258 @@
+r"""Expériences des travaux pratiques : le filtre de l'étudiant, assemblé avec ses fonctions, contre celui
+du paquet, sur les données d'un chapitre.
+
+Chaque expérience prend les fonctions de l'étudiant (mêmes signatures que les exercices de
+:mod:`kalman_course.practice`) ; sans argument, elle prend les solutions de référence du correcteur.
+Le code de l'étudiant n'interrompt jamais l'expérience : s'il échoue, ``student`` vaut ``None`` et
+``message`` dit pourquoi, en français (la figure montre alors le seul filtre du paquet).
+
+* :func:`voltage_lab` — TP 1 : ``predict`` et ``update`` sur la tension constante ;
+* :func:`tag_lab` — TP 2 : l'EKF du tag avec la correction et la jacobienne de l'étudiant ;
+* :func:`pendulum_lab` — TP 3 : un UKF (points sigma et transformée de l'étudiant) et un filtre
+  particulaire (poids et rééchantillonnage de l'étudiant) sur le pendule ;
+* :func:`nile_lab` — TP 4 : le lisseur RTS et l'étape M de l'étudiant sur le Nil.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .. import practice
+from ..core.models import LinearGaussianModel
+from ..datasets import nile
+from ..filters.extended import extended_kalman_filter
+from ..filters.kalman import kalman_filter, predict as kf_predict
+from ..filters.particle import particle_filter
+from ..filters.smoothers import rts_smoother
+from ..filters.unscented import unscented_kalman_filter
+from ..likelihood import expectation_maximization
+from ..practice.nonlinear import point_function
+from ._motion import cv_transition
+from .nile import NILE_DK_VARIANCES, local_level_model
+from .pendulum import pendulum_data, pendulum_model, pendulum_observation, pendulum_transition
+from .tag import TAG_RANGE_STD, tag_data, tag_model, tag_ranges
+from .voltage import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
+
+__all__ = [
+    "LabRun", "voltage_lab", "tag_lab", "pendulum_lab", "nile_lab",
+    "LAB_UKF", "LAB_PARTICLES", "LAB_PF_SEED", "LAB_NILE_PRIOR", "LAB_EM_START", "LAB_EM_ITERATIONS",
+]
+
+#: Points sigma de l'UKF du TP 3 : :math:`\alpha = 1`, :math:`\beta = 2`, :math:`\kappa = 0`.
+LAB_UKF = (1.0, 2.0, 0.0)
+#: Nombre de particules et graine du filtre particulaire du TP 3.
+LAB_PARTICLES = 500
+LAB_PF_SEED = 11
+#: A priori du TP 4 sur le niveau du Nil : :math:`\hat x_0 = 1000` (10⁸ m³), :math:`P_0 = 10^6`.
+LAB_NILE_PRIOR = (np.array([1000.0]), np.array([[1e6]]))
+#: Départ d'EM du TP 4 : :math:`(\sigma^2_\varepsilon, \sigma^2_\eta)`, et nombre d'itérations.
+LAB_EM_START = (1e4, 1e3)
+LAB_EM_ITERATIONS = 30
+
+
+@dataclass(frozen=True, eq=False)
+class LabRun:
+    """Une expérience de TP : ``data`` (ce que la figure trace : temps, vérité, mesures…), ``reference``
+    (le filtre du paquet), ``student`` (le filtre de l'étudiant, ou ``None`` s'il a échoué) et
+    ``message`` (pourquoi, en français ; ``None`` si tout va bien). ``reference`` et ``student`` sont
+    des dictionnaires de tableaux de mêmes clés."""
+
+    data: dict
+    reference: dict
+    student: dict | None
+    message: str | None
+
+
+def _solution(exercise_id: str, fn: Callable | None) -> Callable:
+    return practice.exercise(exercise_id).solution if fn is None else fn
+
+
+def _run(run: Callable[[], dict]) -> tuple[dict | None, str | None]:
+    result = practice.attempt(run)
+    return result.value, result.message
+
+
+# --------------------------------------------------------------------------- TP 1 : tension constante
+
+
+def voltage_lab(predict: Callable | None = None, update: Callable | None = None, n_steps: int = 50) -> LabRun:
+    """Le filtre de l'étudiant (``predict``, ``update``) sur la tension constante (Φ = 10⁻⁵ V²,
+    Ψ = 0,01 V², x̂₀ = 0, P₀ = 1 V²), contre :func:`~kalman_course.kalman_filter`."""
+    predict, update = _solution("kf-predict", predict), _solution("kf-update", update)
+    model = constant_voltage_model(Q=1e-5, R=0.01)
+    z = constant_voltage_measurements(n_steps)
+    ref = kalman_filter(model, z, 0.0, 1.0)
+    A, C, Q, R = (np.array(model.A), np.array(model.C), np.array(model.Q), np.array(model.R))
+
+    def run():
+        x, P = np.array([0.0]), np.array([[1.0]])
+        xs, Ps = [], []
+        for y in z:
+            x, P = predict(x, P, A, Q)
+            x, P = update(x, P, np.atleast_1d(y), C, R)
+            xs.append(np.asarray(x, dtype=float).reshape(1))
+            Ps.append(np.asarray(P, dtype=float).reshape(1, 1))
+        return {"x": np.array(xs)[:, 0], "P": np.array(Ps)[:, 0, 0]}
+
+    student, message = _run(run)
+    data = {"n": np.arange(1, n_steps + 1), "z": np.asarray(z, dtype=float).ravel(), "true": TRUE_VOLTAGE}
+    return LabRun(data, {"x": ref.x[:, 0], "P": ref.P[:, 0, 0]}, student, message)
+
+
+# --------------------------------------------------------------------------- TP 2 : tag UWB
+
+
+def tag_lab(update: Callable | None = None, ranges_jacobian: Callable | None = None) -> LabRun:
+    """L'EKF du tag (prédiction linéaire du paquet) avec la correction ``update`` et la jacobienne
+    ``ranges_jacobian`` de l'étudiant, contre :func:`~kalman_course.extended_kalman_filter`."""
+    update, jacobian = _solution("ekf-update", update), _solution("tag-jacobian", ranges_jacobian)
+    data = tag_data()
+    model = tag_model()
+    ref = extended_kalman_filter(model, data.y, data.x0, data.P0)
+    anchors = np.array(data.anchors)
+    linear = LinearGaussianModel(cv_transition(data.dt), np.eye(1, 4), np.array(model.Q), 1.0)
+    R = TAG_RANGE_STD**2 * np.eye(anchors.shape[0])
+
+    def h(x):
+        return tag_ranges(x, anchors)
+
+    def H(x):
+        return jacobian(x, anchors)
+
+    def run():
+        x, P = np.array(data.x0), np.array(data.P0)
+        xs = []
+        for y in data.y:
+            pred = kf_predict(linear, x, P)
+            x, P = update(pred.x, pred.P, np.array(y), point_function("h", h, 4, "x_pred"),
+                          point_function("H", H, 4, "x_pred"), R)
+            xs.append(np.asarray(x, dtype=float).reshape(4))
+        return {"x": np.array(xs)}
+
+    student, message = _run(run)
+    return LabRun({"t": data.t, "true": data.x_true, "anchors": anchors}, {"x": ref.x}, student, message)
+
+
+# --------------------------------------------------------------------------- TP 3 : pendule
+
+
+def _ukf_run(data, model, sigma_points, unscented_transform) -> dict:
+    alpha, beta, kappa = LAB_UKF
+    f = point_function("f", pendulum_transition, 2, "chi[i]")
+    h = point_function("h", pendulum_observation, 2, "chi[i]")
+    Q, R = np.array(model.Q), np.array(model.R)
+    x, P = np.array(data.x0), np.array(data.P0)
+    xs = []
+    for y in data.y:
+        chi, wm, wc = sigma_points(x, P, alpha, beta, kappa)
+        x_pred, P_pred = unscented_transform(chi, wm, wc, f)
+        x_pred, P_pred = np.asarray(x_pred, dtype=float), np.asarray(P_pred, dtype=float) + Q
+        chi, wm, wc = (np.asarray(a, dtype=float) for a in sigma_points(x_pred, P_pred, alpha, beta, kappa))
+        y_mean, S = unscented_transform(chi, wm, wc, h)
+        y_mean, S = np.asarray(y_mean, dtype=float).reshape(1), np.asarray(S, dtype=float).reshape(1, 1) + R
+        images = np.array([pendulum_observation(c) for c in chi])
+        cross = (wc[:, None] * (chi - x_pred)).T @ (images - y_mean)
+        K = np.linalg.solve(S, cross.T).T
+        x = x_pred + K @ (y - y_mean)
+        P = P_pred - K @ S @ K.T
+        xs.append(x)
+    return {"x": np.array(xs)}
+
+
+def _particle_run(data, model, systematic_resample, particle_weights) -> dict:
+    rng = np.random.default_rng(LAB_PF_SEED)
+    N = LAB_PARTICLES
+    LQ = np.linalg.cholesky(np.array(model.Q))
+    R = np.array(model.R)
+    X = rng.multivariate_normal(np.array(data.x0), np.array(data.P0), size=N)
+    log_w = np.full(N, -np.log(N))
+    xs = []
+    for y in data.y:
+        X = pendulum_transition(X) + rng.standard_normal((N, 2)) @ LQ.T
+        w = np.asarray(particle_weights(log_w, pendulum_observation(X), np.array(y), R), dtype=float)
+        xs.append(w @ X)
+        if 1.0 / np.sum(w**2) < N / 2:
+            idx = np.asarray(systematic_resample(w, float(rng.uniform())), dtype=int)
+            X, log_w = X[idx], np.full(N, -np.log(N))
+        else:
+            log_w = np.log(w)
+    return {"x": np.array(xs)}
+
+
+def pendulum_lab(sigma_points: Callable | None = None, unscented_transform: Callable | None = None,
+                 systematic_resample: Callable | None = None, particle_weights: Callable | None = None) -> LabRun:
+    """Le pendule : l'UKF de l'étudiant (``sigma_points``, ``unscented_transform``) et son filtre
+    particulaire (``systematic_resample``, ``particle_weights``), contre
+    :func:`~kalman_course.unscented_kalman_filter` et :func:`~kalman_course.particle_filter`.
+    ``student`` contient ``ukf`` et ``pf`` (ou ``None`` pour celui qui a échoué, avec son message)."""
+    sp, ut = _solution("sigma-points", sigma_points), _solution("unscented-transform", unscented_transform)
+    rs, pw = _solution("systematic-resample", systematic_resample), _solution("particle-weights", particle_weights)
+    data = pendulum_data()
+    model = pendulum_model()
+    alpha, beta, kappa = LAB_UKF
+    reference = {
+        "ukf": unscented_kalman_filter(model, data.y, data.x0, data.P0, alpha=alpha, beta=beta, kappa=kappa).x,
+        "pf": particle_filter(model, data.y, data.x0, data.P0, n_particles=LAB_PARTICLES, rng=LAB_PF_SEED).x,
+    }
+    ukf, ukf_message = _run(lambda: _ukf_run(data, model, sp, ut))
+    pf, pf_message = _run(lambda: _particle_run(data, model, rs, pw))
+    student = {"ukf": None if ukf is None else ukf["x"], "pf": None if pf is None else pf["x"]}
+    messages = [f"UKF : {ukf_message}" if ukf_message else "", f"filtre particulaire : {pf_message}" if pf_message else ""]
+    message = " ; ".join(m for m in messages if m) or None
+    return LabRun({"t": data.t, "true": data.x_true, "y": data.y}, reference, student, message)
+
+
+# --------------------------------------------------------------------------- TP 4 : le Nil
+
+
+def nile_lab(rts_step: Callable | None = None, m_step: Callable | None = None) -> LabRun:
+    """Le Nil (niveau local, variances de Durbin et Koopman, a priori :data:`LAB_NILE_PRIOR`) : le lissage
+    par le ``rts_step`` de l'étudiant contre :func:`~kalman_course.rts_smoother`, puis
+    :data:`LAB_EM_ITERATIONS` itérations d'EM dont l'étape M est le ``m_step`` de l'étudiant (étape E du
+    paquet) contre :func:`~kalman_course.expectation_maximization`. ``student`` contient ``smoothed``
+    et ``variances`` (ou ``None`` pour la partie qui a échoué)."""
+    rts_step, m_step = _solution("rts-step", rts_step), _solution("em-m-step", m_step)
+    series = nile()
+    y = np.asarray(series.flow, dtype=float)
+    x0, P0 = LAB_NILE_PRIOR
+    model = local_level_model(*NILE_DK_VARIANCES)
+    res = kalman_filter(model, y, x0, P0)
+    smoothed = rts_smoother(model, res)
+    start = local_level_model(*LAB_EM_START)
+    em = expectation_maximization(start, y, x0, P0, max_iter=LAB_EM_ITERATIONS, tol=1e-300)
+    reference = {"smoothed": smoothed.x[:, 0], "variances": np.stack([em.R[:, 0, 0], em.Q[:, 0, 0]], axis=1)}
+    A, Q = np.array(model.A), np.array(model.Q)
+
+    def smooth():
+        xs, Ps = [res.x[-1].copy()], [res.P[-1].copy()]
+        for k in range(len(y) - 2, -1, -1):
+            x_s, P_s = rts_step(res.x[k].copy(), res.P[k].copy(), xs[0], Ps[0], A, Q)
+            xs.insert(0, np.asarray(x_s, dtype=float).reshape(1))
+            Ps.insert(0, np.asarray(P_s, dtype=float).reshape(1, 1))
+        return np.array(xs)[:, 0]
+
+    def learn():
+        current = start
+        variances = [(float(current.R[0, 0]), float(current.Q[0, 0]))]
+        Y = y[:, None]
+        for _ in range(LAB_EM_ITERATIONS):
+            r = kalman_filter(current, Y, x0, P0)
+            sm = rts_smoother(current, r, x0, P0)
+            Q_new, R_new = m_step(Y, np.concatenate([sm.x_initial[None], sm.x]),
+                                  np.concatenate([sm.P_initial[None], sm.P]), np.array(sm.P_lag),
+                                  np.array(current.A), np.array(current.C))
+            Q_new, R_new = np.asarray(Q_new, dtype=float), np.asarray(R_new, dtype=float)
+            current = local_level_model(float(R_new.reshape(-1)[0]), float(Q_new.reshape(-1)[0]))
+            variances.append((float(current.R[0, 0]), float(current.Q[0, 0])))
+        return np.array(variances)
+
+    smooth_values, smooth_message = _run(smooth)
+    em_values, em_message = _run(learn)
+    student = {"smoothed": smooth_values, "variances": em_values}
+    messages = [f"lisseur : {smooth_message}" if smooth_message else "", f"EM : {em_message}" if em_message else ""]
+    message = " ; ".join(m for m in messages if m) or None
+    return LabRun({"year": np.asarray(series.year), "y": y}, reference, student, message)
+

@@ -1,0 +1,690 @@
+"""Travaux pratiques et travaux dirigés : le correcteur ``kalman_course.practice``, les pages TP et TD, les
+carnets de l'étudiant et ``scripts/lab.sh``.
+
+Le code « de l'étudiant » est défini ici comme dans une cellule Jupyter (fichier ``ipykernel_…``, texte
+dans ``linecache``) : le correcteur doit nommer la ligne. Les implémentations justes viennent des
+pages de TP elles-mêmes (leurs solutions) et de filterpy ; les erreurs classiques, des implémentations
+fausses documentées par le correcteur et d'autres, écrites ici à la main.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import linecache
+import os
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.spatial.transform
+import scipy.stats
+
+import kalman_course as kc
+from kalman_course import practice
+from kalman_course.practice import linear, nonlinear, sampling
+from kalman_course.practice.notebooks import lab_pages, student_notebook, write_student_notebooks
+
+ROOT = Path(__file__).resolve().parent.parent
+BOOK = ROOT / "book"
+EXERCISES = practice.exercises()
+LAB_PAGES = [p.stem for p in lab_pages(BOOK)]
+TUTORIAL_PAGES = sorted(p.stem for p in BOOK.glob("td-*.md"))
+
+_CELL = iter(range(10**6))
+
+
+def cell(source: str, name: str):
+    """La fonction ``name`` définie par ``source`` comme dans une cellule de Jupyter."""
+    filename = f"/tmp/ipykernel_4242/{next(_CELL)}.py"
+    linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
+    namespace = {"np": np}
+    exec(compile(source, filename, "exec"), namespace)  # noqa: S102 — le code de l'étudiant, ici
+    return namespace[name]
+
+
+# --------------------------------------------------------------------------- la liste des exercices
+
+
+def test_at_least_twelve_exercises_each_with_an_id_a_french_title_and_a_chapter():
+    assert len(EXERCISES) >= 12
+    ids = [ex.id for ex in EXERCISES]
+    assert len(set(ids)) == len(ids)
+    chapters = set(re.findall(r"file: book/([\w-]+)", (ROOT / "_toc.yml").read_text()))
+    for ex in EXERCISES:
+        assert re.fullmatch(r"[a-z0-9]+(-[a-z0-9]+)*", ex.id)
+        assert ex.title and ex.title[0].isupper()
+        assert ex.chapter in chapters, f"{ex.id} : chapitre {ex.chapter} absent du livre"
+
+
+def test_the_six_named_exercises_have_exactly_the_given_signatures():
+    signatures = {ex.id: ex.signature for ex in EXERCISES}
+    assert signatures["kf-predict"] == "predict(x, P, A, Q) -> (x_pred, P_pred)"
+    assert signatures["kf-update"] == "update(x_pred, P_pred, y, C, R) -> (x, P)"
+    assert signatures["ekf-update"] == "update(x_pred, P_pred, y, h, H, R) -> (x, P)"
+    assert signatures["sigma-points"] == "sigma_points(x, P, alpha, beta, kappa) -> (chi, wm, wc)"
+    assert signatures["systematic-resample"] == "systematic_resample(weights, u) -> indices"
+    assert signatures["rts-step"] == ("rts_step(x_filt, P_filt, x_smooth_next, P_smooth_next, A, Q) "
+                                      "-> (x_smooth, P_smooth)")
+    for ex in EXERCISES:  # la signature déclarée et les paramètres appelés sont les mêmes
+        assert ex.signature.startswith(ex.signature.split("(")[0] + "(" + ", ".join(ex.parameters) + ")")
+
+
+def test_every_exercise_documents_at_least_three_mistakes_with_specific_hints():
+    for ex in EXERCISES:
+        assert len(ex.mistakes) >= 3, ex.id
+        ids = [m.id for m in ex.mistakes]
+        hints = [m.hint for m in ex.mistakes]
+        assert len(set(ids)) == len(ids) and len(set(hints)) == len(hints), ex.id
+        for m in ex.mistakes:
+            assert len(m.hint) > 60 and len(m.title) > 5, (ex.id, m.id)
+            assert callable(m.example), (ex.id, m.id)
+
+
+def test_every_exercise_is_practised_in_a_lab_page():
+    checked = set()
+    for page in LAB_PAGES:
+        checked |= set(re.findall(r'practice\.check\("([\w-]+)"', (BOOK / f"{page}.md").read_text()))
+    assert checked == {ex.id for ex in EXERCISES}
+
+
+def test_hidden_cases_vary_sizes_and_cover_the_announced_difficulties():
+    labels = {ex.id: " ".join(c.label for c in ex.cases()) for ex in EXERCISES}
+    assert "non symétrique" in labels["kf-predict"]
+    assert "linéaire" in labels["ekf-update"] and "distances" in labels["ekf-update"]
+    assert "ω = 0" in labels["so3-exp"] and "u = 0" in labels["systematic-resample"]
+    assert "très loin" in labels["particle-weights"]
+    for ex in EXERCISES:
+        cases = ex.cases()
+        assert len(cases) >= 4, ex.id
+        if ex.id == "so3-exp":  # une rotation est toujours (3,) : les cas varient l'angle (0, 10⁻⁹, π…)
+            continue
+        shapes = {tuple(np.shape(a) for a in c.args if isinstance(a, np.ndarray)) for c in cases}
+        assert len(shapes) >= 3, f"{ex.id} : les cas cachés ont presque tous les mêmes tailles"
+
+
+# --------------------------------------------------------------------------- erreurs classiques
+
+MISTAKES = [(ex.id, m.id) for ex in EXERCISES for m in ex.mistakes]
+
+
+@pytest.mark.parametrize("exercise_id, mistake_id", MISTAKES)
+def test_each_documented_mistake_gets_its_specific_hint(exercise_id, mistake_id):
+    mistake = next(m for m in practice.exercise(exercise_id).mistakes if m.id == mistake_id)
+    verdict = practice.check(exercise_id, mistake.example)
+    assert not verdict.passed
+    assert verdict.kind == "erreur classique" and verdict.mistake == mistake_id, verdict.feedback
+    assert mistake.hint in verdict.feedback
+
+
+# Erreurs écrites comme un étudiant les écrit (indépendamment des exemples du correcteur) : l'erreur
+# reconnue et la ligne nommée (le texte de la ligne fautive).
+STUDENT_MISTAKES = [
+    ("kf-predict", "apa", "P_pred = A @ P @ A + Q", """\
+def predict(x, P, A, Q):
+    x_pred = A @ x
+    P_pred = A @ P @ A + Q
+    return x_pred, P_pred
+"""),
+    ("kf-predict", "elementwise", "P_pred = A * P * A.T + Q", """\
+def predict(x, P, A, Q):
+    x_pred = np.dot(A, x)
+    P_pred = A * P * A.T + Q
+    return x_pred, P_pred
+"""),
+    ("kf-update", "gain-r", "K = P_pred @ C.T @ np.linalg.inv(R)", """\
+def update(x_pred, P_pred, y, C, R):
+    nu = y - C @ x_pred
+    K = P_pred @ C.T @ np.linalg.inv(R)
+    return x_pred + K @ nu, (np.eye(len(x_pred)) - K @ C) @ P_pred
+"""),
+    ("kf-update", "p-before-k", "K = P @ C.T @ np.linalg.inv(S)", """\
+def update(x_pred, P_pred, y, C, R):
+    S = C @ P_pred @ C.T + R
+    P = P_pred - P_pred @ C.T @ np.linalg.solve(S, C @ P_pred)
+    K = P @ C.T @ np.linalg.inv(S)
+    x = x_pred + K @ (y - C @ x_pred)
+    return x, P
+"""),
+    ("ekf-update", "hx-innovation", "x = x_pred + K @ (y - Hk @ x_pred)", """\
+def update(x_pred, P_pred, y, h, H, R):
+    Hk = H(x_pred)
+    K = P_pred @ Hk.T @ np.linalg.inv(Hk @ P_pred @ Hk.T + R)
+    x = x_pred + K @ (y - Hk @ x_pred)
+    return x, P_pred - K @ Hk @ P_pred
+"""),
+    ("ekf-update", "function-as-array", "S = H @ P_pred @ H.T + R", """\
+def update(x_pred, P_pred, y, h, H, R):
+    S = H @ P_pred @ H.T + R
+    K = P_pred @ H.T @ np.linalg.inv(S)
+    return x_pred + K @ (y - h(x_pred)), P_pred
+"""),
+    ("sigma-points", "cholesky-rows", "chi = np.vstack([x, x + L, x - L])", """\
+def sigma_points(x, P, alpha, beta, kappa):
+    n = len(x)
+    lam = alpha**2 * (n + kappa) - n
+    L = np.linalg.cholesky((n + lam) * P)
+    chi = np.vstack([x, x + L, x - L])
+    wm = np.full(2 * n + 1, 0.5 / (n + lam)); wm[0] = lam / (n + lam)
+    wc = wm.copy(); wc[0] += 1 - alpha**2 + beta
+    return chi, wm, wc
+"""),
+    ("sigma-points", "wc-equals-wm", "wc = wm", """\
+def sigma_points(x, P, alpha, beta, kappa):
+    n = len(x)
+    lam = alpha**2 * (n + kappa) - n
+    S = np.linalg.cholesky((n + lam) * P)
+    chi = np.array([x] + [x + S[:, i] for i in range(n)] + [x - S[:, i] for i in range(n)])
+    wm = np.full(2 * n + 1, 0.5 / (n + lam)); wm[0] = lam / (n + lam)
+    wc = wm
+    return chi, wm, wc
+"""),
+    ("unscented-transform", "cov-with-wm", "cov = sum(wm[i] * np.outer(Y[i] - mean, Y[i] - mean) for i in range(len(Y)))", """\
+def unscented_transform(chi, wm, wc, f):
+    Y = np.array([f(c) for c in chi])
+    mean = sum(wm[i] * Y[i] for i in range(len(Y)))
+    cov = sum(wm[i] * np.outer(Y[i] - mean, Y[i] - mean) for i in range(len(Y)))
+    return mean, cov
+"""),
+    ("systematic-resample", "u-plus-i-over-n", "positions = u + np.arange(N) / N", """\
+def systematic_resample(weights, u):
+    N = len(weights)
+    positions = u + np.arange(N) / N
+    return np.searchsorted(np.cumsum(weights), positions, side="right")
+"""),
+    ("systematic-resample", "left-side", "while c[j] < p:", """\
+def systematic_resample(weights, u):
+    N = len(weights)
+    c = np.cumsum(weights)
+    out = []
+    j = 0
+    for i in range(N):
+        p = (u + i) / N
+        while c[j] < p:
+            j += 1
+        out.append(j)
+    return np.array(out)
+"""),
+    ("particle-weights", "no-max-shift", "w = np.exp(logw)", """\
+def particle_weights(log_weights, predicted, y, R):
+    d = y - predicted
+    logw = log_weights - 0.5 * np.einsum("ni,ij,nj->n", d, np.linalg.inv(R), d)
+    w = np.exp(logw)
+    return w / np.sum(w)
+"""),
+    ("rts-step", "smoothed-gain", "G = P_filt @ A.T @ np.linalg.inv(P_smooth_next)", """\
+def rts_step(x_filt, P_filt, x_smooth_next, P_smooth_next, A, Q):
+    P_pred = A @ P_filt @ A.T + Q
+    G = P_filt @ A.T @ np.linalg.inv(P_smooth_next)
+    x_s = x_filt + G @ (x_smooth_next - A @ x_filt)
+    P_s = P_filt + G @ (P_smooth_next - P_pred) @ G.T
+    return x_s, P_s
+"""),
+    ("em-m-step", "means-only", "", """\
+def m_step(y, x_smooth, P_smooth, P_lag, A, C):
+    r = x_smooth[1:] - x_smooth[:-1] @ A.T
+    e = y - x_smooth[1:] @ C.T
+    return r.T @ r / len(y), e.T @ e / len(y)
+"""),
+    ("so3-exp", "nan-at-zero", "k = omega / theta", """\
+def so3_exp(omega):
+    theta = np.linalg.norm(omega)
+    k = omega / theta
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(theta) * K + (1 - np.cos(theta)) * K @ K
+"""),
+    ("tag-jacobian", "sign", "", """\
+def ranges_jacobian(x, anchors):
+    H = np.zeros((len(anchors), 4))
+    for i, a in enumerate(anchors):
+        d = a - x[:2]
+        H[i, :2] = d / np.linalg.norm(d)
+    return H
+"""),
+    ("nis", "s-not-inverted", "return np.array([nu @ Sk @ nu for nu, Sk in zip(innovations, S)])", """\
+def nis(innovations, S):
+    return np.array([nu @ Sk @ nu for nu, Sk in zip(innovations, S)])
+"""),
+    ("joseph-update", "short-form", "P = (np.eye(len(x_pred)) - K @ C) @ P_pred", """\
+def joseph_update(x_pred, P_pred, y, C, R, K):
+    x = x_pred + K @ (y - C @ x_pred)
+    P = (np.eye(len(x_pred)) - K @ C) @ P_pred
+    return x, P
+"""),
+]
+
+
+@pytest.mark.parametrize("exercise_id, mistake_id, line, source", STUDENT_MISTAKES,
+                         ids=[f"{e}-{m}" for e, m, _, _ in STUDENT_MISTAKES])
+def test_student_written_mistakes_are_recognised_and_their_line_named(exercise_id, mistake_id, line, source):
+    name = re.match(r"def (\w+)", source).group(1)
+    verdict = practice.check(exercise_id, cell(source, name))
+    assert not verdict.passed and verdict.mistake == mistake_id, verdict.feedback
+    assert "de votre cellule" in verdict.feedback
+    if line:
+        number = next(i for i, text in enumerate(source.splitlines(), 1) if text.strip() == line)
+        assert verdict.line == number, verdict.feedback
+        assert f"`{line}`" in verdict.feedback
+
+
+# --------------------------------------------------------------------------- solutions justes
+
+
+def _page_cells(page: str) -> list[tuple[str, str]]:
+    """Les cellules de code d'une page : (« skeleton », « solution » ou « other », source)."""
+    text = (BOOK / f"{page}.md").read_text()
+    cells = []
+    for m in re.finditer(r"```\{code-cell\}[^\n]*\n(.*?)```", text, re.S):
+        before = text[:m.start()]
+        inside = before.rfind("```{solution-start}") > before.rfind("```{solution-end}")
+        body = re.sub(r"^(:[\w-]+:.*\n)+", "", m.group(1))
+        kind = "solution" if inside else ("skeleton" if "raise NotImplementedError" in body else "other")
+        cells.append((kind, body))
+    return cells
+
+
+def _lab_functions(page: str, kind: str) -> dict[str, tuple[str, object]]:
+    """Exercice → fonction (squelettes ou solutions de la page), d'après la vérification qui suit."""
+    cells = _page_cells(page)
+    out = {}
+    last = {}
+    for k, body in cells:
+        if k == kind:
+            name = re.match(r"def (\w+)", body).group(1)
+            last[name] = cell(body, name)
+        m = re.match(r'practice\.check\("([\w-]+)", (\w+)\)', body.strip())
+        if m:
+            out[m.group(1)] = last[m.group(2)]
+    return out
+
+
+@pytest.mark.parametrize("page", LAB_PAGES)
+def test_lab_page_solutions_pass_and_skeletons_are_not_yet_written(page):
+    solutions = _lab_functions(page, "solution")
+    skeletons = _lab_functions(page, "skeleton")
+    assert solutions and solutions.keys() == skeletons.keys()
+    for exercise_id, fn in solutions.items():
+        verdict = practice.check(exercise_id, fn)
+        assert verdict.passed, verdict.feedback
+        assert verdict._repr_html_().count("kc-verdict-reussi") == 1
+    for exercise_id, fn in skeletons.items():
+        verdict = practice.check(exercise_id, fn)
+        assert not verdict.passed and verdict.kind == "pas écrite"
+        assert "pas encore écrite" in verdict.feedback and "`raise NotImplementedError`" in verdict.feedback
+        assert verdict.line is not None
+
+
+def test_independent_implementations_from_filterpy_pass(monkeypatch):
+    """filterpy (fonctions predict/update, MerweScaledSigmaPoints, unscented_transform,
+    systematic_resample) : écrit par d'autres, il passe le correcteur — les cas cachés et leurs
+    références ne dépendent pas de nos propres conventions."""
+    import filterpy.kalman as fk
+    import filterpy.monte_carlo.resampling as fr
+
+    def predict(x, P, A, Q):
+        return fk.predict(x, P, A, Q)
+
+    def update(x_pred, P_pred, y, C, R):
+        return fk.update(x_pred, P_pred, y, R, C)
+
+    def sigma_points(x, P, alpha, beta, kappa):
+        points = fk.MerweScaledSigmaPoints(len(x), alpha, beta, kappa)
+        return points.sigma_points(x, P), points.Wm, points.Wc
+
+    def unscented_transform(chi, wm, wc, f):
+        return fk.unscented_transform(np.array([f(c) for c in chi]), wm, wc)
+
+    def systematic_resample(weights, u):
+        monkeypatch.setattr(fr, "random", lambda: u)
+        return fr.systematic_resample(weights)
+
+    for exercise_id, fn in (("kf-predict", predict), ("kf-update", update), ("sigma-points", sigma_points),
+                            ("unscented-transform", unscented_transform),
+                            ("systematic-resample", systematic_resample)):
+        verdict = practice.check(exercise_id, fn)
+        assert verdict.passed, (exercise_id, verdict.feedback)
+
+
+def test_closed_form_references_agree_with_independent_computations():
+    rng = np.random.default_rng(0)
+    # forme de Joseph au gain optimal = correction de filterpy (qui utilise Joseph)
+    import filterpy.kalman as fk
+
+    for case in linear.JOSEPH_UPDATE.cases():
+        x, P, y, C, R, K = case.args
+        optimal = np.linalg.solve(C @ P @ C.T + R, C @ P).T
+        x_ref, P_ref = linear.joseph_reference(x, P, y, C, R, optimal)
+        x_fp, P_fp = fk.update(x, P, y, R, C)
+        assert np.allclose(x_ref, x_fp, atol=1e-10) and np.allclose(P_ref, P_fp, atol=1e-10)
+    # NIS = kc.nis d'un vrai filtre
+    model = kc.LinearGaussianModel(np.eye(2), rng.standard_normal((2, 2)), 0.1 * np.eye(2), np.eye(2))
+    res = kc.kalman_filter(model, rng.standard_normal((20, 2)), np.zeros(2), np.eye(2))
+    assert np.allclose(linear.nis_reference(res.innovation, res.S), kc.nis(res), rtol=1e-10)
+    # poids des particules = densités gaussiennes directes, normalisées (cas sans débordement)
+    log_w = np.log(rng.dirichlet(np.ones(7)))
+    pred, y, R = rng.standard_normal((7, 2)), rng.standard_normal(2), np.array([[0.5, 0.1], [0.1, 0.3]])
+    direct = np.exp(log_w) * scipy.stats.multivariate_normal(y, R).pdf(pred)
+    assert np.allclose(sampling.particle_weights_reference(log_w, pred, y, R), direct / direct.sum(), rtol=1e-10)
+    # jacobienne des distances = différences finies ; exponentielle de SO(3) = scipy Rotation
+    for case in nonlinear.TAG_JACOBIAN.cases():
+        x, anchors = case.args
+        numeric = kc.numerical_jacobian(lambda z: np.linalg.norm(z[:2] - anchors, axis=1), x)
+        assert np.allclose(case.expected[0], numeric, atol=1e-6)
+    for case in nonlinear.SO3_EXP.cases():
+        rotation = scipy.spatial.transform.Rotation.from_rotvec(case.args[0]).as_matrix()
+        assert np.allclose(case.expected[0], rotation, atol=1e-12)
+
+
+# --------------------------------------------------------------------------- jamais d'exception
+
+_NASTY = {
+    "exception": "def predict(x, P, A, Q):\n    raise ValueError('oups')\n",
+    "exception maison": "class Erreur(Exception):\n    pass\n\ndef predict(x, P, A, Q):\n    raise Erreur()\n",
+    "nom inconnu": "def predict(x, P, A, Q):\n    return A @ x, A @ PP @ A.T + Q\n",
+    "division par zéro": "def predict(x, P, A, Q):\n    return A @ x, P / 0\n",
+    "récursion": "def predict(x, P, A, Q):\n    return predict(x, P, A, Q)\n",
+    "sys.exit": "import sys\n\ndef predict(x, P, A, Q):\n    sys.exit(1)\n",
+    "rien": "def predict(x, P, A, Q):\n    x_pred = A @ x\n",
+    "texte": "def predict(x, P, A, Q):\n    return 'x', 'P'\n",
+    "trois valeurs": "def predict(x, P, A, Q):\n    return A @ x, A @ P @ A.T + Q, 0\n",
+    "une seule valeur": "def predict(x, P, A, Q):\n    return A @ P @ A.T + Q\n",
+    "générateur": "def predict(x, P, A, Q):\n    yield A @ x\n",
+    "objet étrange": ("class Bizarre:\n    def __array__(self, *a, **k):\n        raise RuntimeError('non')\n\n"
+                      "def predict(x, P, A, Q):\n    return Bizarre(), Bizarre()\n"),
+    "dictionnaire": "def predict(x, P, A, Q):\n    return {'x': x}, P\n",
+    "NaN": "def predict(x, P, A, Q):\n    return A @ x, np.full(P.shape, np.nan)\n",
+    "non symétrique": "def predict(x, P, A, Q):\n    return A @ x, A @ P @ A.T + Q + np.triu(np.ones_like(P), 1)\n",
+    "colonne": "def predict(x, P, A, Q):\n    return (A @ x)[:, None], A @ P @ A.T + Q\n",
+    "mauvaise forme": "def predict(x, P, A, Q):\n    return A @ x, np.zeros(3)\n",
+    "modifie P": "def predict(x, P, A, Q):\n    P += Q\n    return A @ x, A @ P @ A.T\n",
+    "hasard": "def predict(x, P, A, Q):\n    return A @ x + 1e-3 * np.random.standard_normal(len(x)), A @ P @ A.T + Q\n",
+    "bavarde": "def predict(x, P, A, Q):\n    print('coucou')\n    np.log(-1.0)\n    return A @ x, A @ P\n",
+    "boucle sans fin": "def predict(x, P, A, Q):\n    while True:\n        pass\n",
+    "mauvaise signature": "def predict(x, P):\n    return x, P\n",
+}
+
+
+@pytest.mark.parametrize("what", list(_NASTY))
+def test_check_never_raises_and_explains_in_french(what, monkeypatch, capsys):
+    monkeypatch.setattr(practice.student, "TIME_LIMIT", 0.5)
+    fn = cell(_NASTY[what], "predict")
+    verdict = practice.check("kf-predict", fn)
+    assert isinstance(verdict, practice.Verdict) and not verdict.passed
+    assert verdict.feedback and "Traceback" not in verdict.feedback
+    assert re.search(r"[éèàù]|votre|Votre", verdict.feedback), verdict.feedback
+    if what in ("modifie P",):
+        assert "sur place" in verdict.feedback and "`P += Q`" in verdict.feedback
+    if what == "boucle sans fin":
+        assert "n'a pas rendu la main" in verdict.feedback
+    if what == "colonne":
+        assert "(1, 1)" in verdict.feedback and "attendu (1,)" in verdict.feedback
+    if what == "non symétrique":
+        assert "pas symétrique" in verdict.feedback
+    if what == "hasard":
+        assert "deux résultats" in verdict.feedback
+
+
+def test_check_refuses_gently_what_is_not_a_function_or_not_an_exercise():
+    fn = cell("def predict(x, P, A, Q):\n    return A @ x, A @ P @ A.T + Q\n", "predict")
+    assert practice.check("kf-predict", fn).passed
+    for verdict in (practice.check("kf-predict", 3), practice.check("kf-predit", fn), practice.check(None, fn)):
+        assert not verdict.passed and verdict.feedback
+    assert "Exercices : kf-predict" in practice.check("kf-predit", fn).feedback
+    with pytest.raises(kc.KalmanInputError, match="Exercice inconnu"):
+        practice.exercise("kf-predit")
+
+
+def test_verdict_displays_as_a_box_that_says_the_result_in_words_not_only_in_colour():
+    good = practice.check("kf-predict", linear.predict_solution)
+    bad = practice.check("kf-predict", cell("def predict(x, P, A, Q):\n    raise NotImplementedError\n", "predict"))
+    for verdict, word, css in ((good, "✔ Réussi", "kc-verdict-reussi"), (bad, "✘ À corriger", "kc-verdict-a-corriger")):
+        html = verdict._repr_html_()
+        assert css in html and 'role="status"' in html and word in html and word in str(verdict)
+        assert "<code>raise NotImplementedError</code>" in html or verdict.passed
+    assert "<script" not in practice.check("kf-predict", cell(
+        "def predict(x, P, A, Q):\n    raise ValueError('<script>alert(1)</script>')\n", "predict"))._repr_html_()
+
+
+# --------------------------------------------------------------------------- TP : expériences et figures
+
+
+def test_lab_experiments_with_the_page_solutions_equal_the_package_filters():
+    s = {**_lab_functions("tp-filtre-lineaire", "solution"), **_lab_functions("tp-ekf-tag", "solution"),
+         **_lab_functions("tp-ukf-particulaire", "solution"), **_lab_functions("tp-lissage-em", "solution")}
+    labs = kc.scenarios.labs
+    run = labs.voltage_lab(s["kf-predict"], s["kf-update"])
+    assert run.message is None
+    assert np.allclose(run.student["x"], run.reference["x"], atol=1e-12)
+    assert np.allclose(run.student["P"], run.reference["P"], rtol=1e-10)
+    run = labs.tag_lab(s["ekf-update"], s["tag-jacobian"])
+    assert run.message is None and np.allclose(run.student["x"], run.reference["x"], atol=1e-8)
+    run = labs.pendulum_lab(s["sigma-points"], s["unscented-transform"], s["systematic-resample"],
+                            s["particle-weights"])
+    assert run.message is None and np.allclose(run.student["ukf"], run.reference["ukf"], atol=1e-9)
+    # filtre particulaire : mêmes lois, tirages différents — même précision, pas mêmes valeurs
+    truth = run.data["true"][:, 0]
+    rmse = [np.sqrt(np.mean((x[:, 0] - truth) ** 2)) for x in (run.student["pf"], run.reference["pf"])]
+    assert 0.5 < rmse[0] / rmse[1] < 2.0
+    run = labs.nile_lab(s["rts-step"], s["em-m-step"])
+    assert run.message is None
+    assert np.allclose(run.student["smoothed"], run.reference["smoothed"], rtol=1e-10)
+    assert np.allclose(run.student["variances"], run.reference["variances"], rtol=1e-8)
+
+
+def test_lab_figures_show_only_the_package_and_say_why_when_the_student_code_fails():
+    blank = cell("def predict(x, P, A, Q):\n    raise NotImplementedError\n", "predict")
+    fig = kc.figures.draw("tp-tension", predict=blank)
+    assert "pas encore écrite" in fig._suptitle.get_text() and "ligne 2 de votre cellule" in fig._suptitle.get_text()
+    assert len(fig.axes[0].get_lines()) == 3  # valeur vraie, mesures, paquet : pas de courbe de l'étudiant
+    broken = cell("def update(x_pred, P_pred, y, h, H, R):\n    return x_pred\n", "update")
+    run = kc.scenarios.labs.tag_lab(update=broken)
+    assert run.student is None and run.message
+    assert kc.figures.draw("tp-tension")._suptitle is None
+
+
+# --------------------------------------------------------------------------- TD : réponses recalculées
+
+
+def _page(page: str) -> str:
+    return (BOOK / f"{page}.md").read_text()
+
+
+def test_tutorial_one_answers_are_the_package_values():
+    text = _page("td-filtre-lineaire")
+    step = kc.scenarios.tutorials.thermometer_update()
+    assert "$S = 4 + 1 = 5$, $K = 4/5 = 0{,}8$" in text
+    assert r"$\hat x = 20 + 0{,}8 \times (23 - 20) = 22{,}4$ °C" in text
+    assert r"$P = (1 - 0{,}8) \times 4 = 0{,}8$ °C²" in text
+    assert step.K[0, 0] == pytest.approx(0.8, abs=1e-14) and step.S[0, 0] == pytest.approx(5.0)
+    assert step.x[0] == pytest.approx(22.4, abs=1e-12) and step.P[0, 0] == pytest.approx(0.8, abs=1e-14)
+
+
+def test_tutorial_two_answers_are_the_package_values():
+    text = _page("td-filtres-a-points")
+    ut = kc.scenarios.tutorials.square_transform()
+    assert r"$\chi = (0,\ \sqrt3,\ -\sqrt3)$" in text and r"$W^m = W^c = (2/3,\ 1/6,\ 1/6)$" in text
+    assert np.allclose(ut.points, [0.0, np.sqrt(3), -np.sqrt(3)], atol=1e-14)
+    assert np.allclose(ut.Wm, [2 / 3, 1 / 6, 1 / 6], atol=1e-14) and np.allclose(ut.Wc, ut.Wm, atol=1e-14)
+    assert r"\tfrac16 \cdot 3 = 1$" in text and r"\tfrac43 = 2$" in text
+    assert ut.mean == pytest.approx(1.0, abs=1e-12) and ut.variance == pytest.approx(2.0, abs=1e-12)
+    assert "$f(0) = 0$ et $f'(0)^2 \\cdot 1 = 0$" in text
+    assert ut.linearised_mean == 0.0 and ut.linearised_variance == 0.0
+    # rééchantillonnage : positions, sommes cumulées, particules copiées (numérotées à partir de 1)
+    assert "Positions : $0{,}125$, $0{,}375$, $0{,}625$, $0{,}875$" in text
+    assert "Le nouveau nuage est $(x^2, x^3, x^4, x^4)$" in text
+    assert list(kc.scenarios.tutorials.four_particles() + 1) == [2, 3, 4, 4]
+    assert "$N w^4 = 1{,}6$ copies" in text and "toujours 1 ou 2" in text
+    weights = kc.scenarios.tutorials.FOUR_WEIGHTS
+    assert 4 * weights[3] == pytest.approx(1.6)
+    copies = {int(np.sum(kc.systematic_resample(weights, u) == 3)) for u in np.linspace(0, 1, 200, endpoint=False)}
+    assert copies == {1, 2}
+    # EnKF : (1 − K)² P + K² R = (1 − K) P = 0,8 ; sans perturbation 0,16
+    spread = kc.scenarios.tutorials.ensemble_spread()
+    assert r"$0{,}04 \times 4 + 0{,}64 \times 1 = 0{,}8$ ; sans, $0{,}16$" in text
+    assert spread["exact"] == pytest.approx(0.8, abs=1e-14)
+    assert spread["exact_unperturbed"] == pytest.approx(0.16, abs=1e-14)
+    assert spread["perturbed"] == pytest.approx(0.8, rel=0.02)
+    assert spread["unperturbed"] == pytest.approx(0.16, rel=0.02)
+
+
+def _fractions(text: str, symbol: str) -> list[Fraction]:
+    """Les valeurs « symbole = … = a/b » écrites dans la page (la dernière égalité de chaque calcul)."""
+    pattern = re.escape(symbol) + r"[^$]*?= (\d+)/(\d+)(?=[$,])"
+    return [Fraction(int(a), int(b)) for a, b in re.findall(pattern, text)]
+
+
+def test_tutorial_three_answers_are_the_package_values():
+    text = _page("td-lissage-em")
+    steps = kc.scenarios.tutorials.three_step_smoothing()
+    for k in (1, 2, 3):
+        assert _fractions(text, rf"\hat x_{{{k}|{k}}}")[0] == pytest.approx(steps.x[k - 1], abs=1e-14)
+        assert _fractions(text, rf"P_{{{k}|{k}}}")[0] == pytest.approx(steps.P[k - 1], abs=1e-14)
+        assert _fractions(text, rf"\hat x_{{{k}|3}}")[0] == pytest.approx(steps.xs[k - 1], abs=1e-14) \
+            if k < 3 else True
+    for k in (1, 2):
+        assert _fractions(text, rf"P_{{{k}|3}}")[0] == pytest.approx(steps.Ps[k - 1], abs=1e-14)
+        assert _fractions(text, rf"G_{k}")[0] == pytest.approx(steps.G[k - 1], abs=1e-14)
+    assert "$\\hat x_{3|3} = 43/21$, $P_{3|3} = 13/21$" in text  # le départ du lisseur
+    assert steps.xs[2] == pytest.approx(43 / 21) and steps.Ps[2] == pytest.approx(13 / 21)
+    assert _fractions(text, "R'")[-1] == pytest.approx(steps.R_new, abs=1e-14)
+    assert "= 40/49$" in text
+
+
+# --------------------------------------------------------------------------- carnets de l'étudiant
+
+
+def test_student_notebooks_follow_the_lab_pages(tmp_path):
+    written = write_student_notebooks(BOOK, tmp_path)
+    assert [p.name for p in written] == [f"{page}.ipynb" for page in LAB_PAGES]
+    for path in written:
+        committed = BOOK / "travaux-pratiques" / path.name
+        assert committed.is_file(), f"{committed} manque : python -m kalman_course.practice --notebooks book/travaux-pratiques"
+        assert committed.read_bytes() == path.read_bytes(), (
+            f"{committed.name} ne suit plus sa page : python -m kalman_course.practice --notebooks book/travaux-pratiques")
+
+
+@pytest.mark.parametrize("page", LAB_PAGES)
+def test_student_notebook_has_the_blanks_the_checks_and_no_solution(page):
+    nb = student_notebook(BOOK / f"{page}.md", BOOK)
+    code = [c.source for c in nb.cells if c.cell_type == "code"]
+    text = "\n".join(c.source for c in nb.cells)
+    skeletons = [body.strip() for kind, body in _page_cells(page) if kind == "skeleton"]
+    solutions = [body.strip() for kind, body in _page_cells(page) if kind == "solution"]
+    assert skeletons and all(s in code for s in skeletons)
+    assert all("# À vous" in s for s in skeletons)
+    assert not any(s in text for s in solutions)
+    assert "solution-start" not in text and "{exercise}" not in text and "{doc}" not in text
+    assert sum("practice.check(" in c for c in code) == len(skeletons)
+    assert any("kc.figures.draw(" in c for c in code) and code[0].startswith("import numpy as np")
+    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code")
+
+
+@pytest.mark.parametrize("page", LAB_PAGES)
+def test_student_notebook_runs_and_every_check_says_not_yet_written(page, monkeypatch):
+    """Le carnet de l'étudiant, exécuté tel quel (cellule par cellule, comme Jupyter) : aucune
+    exception, chaque vérification répond « pas encore écrite », la figure ne montre que le paquet."""
+    nb = student_notebook(BOOK / f"{page}.md", BOOK)
+    namespace: dict = {}
+    verdicts, figures = [], []
+    for c in nb.cells:
+        if c.cell_type != "code":
+            continue
+        source = c.source
+        filename = f"/tmp/ipykernel_4242/{page}-{c['id']}.py"
+        linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
+        if source.startswith(("practice.", "kc.")):  # une expression : sa valeur est affichée
+            value = eval(compile(source.strip(), filename, "eval"), namespace)  # noqa: S307
+            (verdicts if isinstance(value, practice.Verdict) else figures).append(value)
+        else:
+            exec(compile(source, filename, "exec"), namespace)  # noqa: S102
+    assert verdicts and all(v.kind == "pas écrite" and "pas encore écrite" in v.feedback for v in verdicts)
+    assert figures and all("pas encore écrite" in f._suptitle.get_text() for f in figures)
+
+
+# --------------------------------------------------------------------------- scripts/lab.sh
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_lab_script_opens_jupyterlab_offline_on_the_lab_notebooks(tmp_path):
+    """``bash scripts/lab.sh`` : copie les carnets dans travaux-pratiques/ (sans écraser un carnet
+    commencé) et sert JupyterLab sur ce dossier ; l'API liste les carnets et la page /lab se charge."""
+    work = ROOT / "travaux-pratiques"
+    had_work = work.exists()
+    if not had_work:  # un carnet « commencé » par l'étudiant : lab.sh ne doit pas l'écraser
+        work.mkdir()
+        (work / f"{LAB_PAGES[0]}.ipynb").write_text((BOOK / "travaux-pratiques" / f"{LAB_PAGES[0]}.ipynb")
+                                                    .read_text().replace("# À vous", "# commencé"))
+    existed = {p.name: p.read_bytes() for p in work.glob("*.ipynb")}
+    port = _free_port()
+    log = tmp_path / "lab.log"
+    env = {**os.environ, "JUPYTER_CONFIG_DIR": str(tmp_path / "config"), "JUPYTER_RUNTIME_DIR": str(tmp_path / "rt"),
+           "JUPYTERLAB_SETTINGS_DIR": str(tmp_path / "settings"), "JUPYTERLAB_WORKSPACES_DIR": str(tmp_path / "ws")}
+    with open(log, "w") as out:
+        proc = subprocess.Popen(["bash", str(ROOT / "scripts" / "lab.sh"), "--no-browser", f"--port={port}",
+                                 "--ServerApp.port_retries=0", "--IdentityProvider.token=", "--ServerApp.ip=127.0.0.1"],
+                                cwd=ROOT, stdout=out, stderr=subprocess.STDOUT, env=env, start_new_session=True)
+    try:
+        listing = None
+        for _ in range(240):
+            with contextlib.suppress(OSError):
+                with urllib.request.urlopen(f"http://127.0.0.1:{port}/api/contents", timeout=5) as r:
+                    listing = r.read().decode()
+                break
+            assert proc.poll() is None, log.read_text()[-3000:]
+            time.sleep(0.5)
+        assert listing is not None, log.read_text()[-3000:]
+        names = set(re.findall(r'"name": ?"([^"]+\.ipynb)"', listing))
+        assert names >= {f"{page}.ipynb" for page in LAB_PAGES}
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/lab", timeout=10) as r:
+            assert r.status == 200 and "JupyterLab" in r.read().decode()
+        for name, content in existed.items():  # un carnet commencé n'est jamais écrasé
+            assert (work / name).read_bytes() == content
+        for page in LAB_PAGES:
+            assert (work / f"{page}.ipynb").is_file()
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGTERM)
+        proc.wait(timeout=30)
+        if not had_work:  # le dossier de travail n'existait pas : on le retire
+            shutil.rmtree(work, ignore_errors=True)
+
+
+def test_binder_opens_the_lab_notebooks_with_the_pinned_jupyterlab():
+    post = (ROOT / "binder" / "postBuild").read_text()
+    folder = re.search(r'default_url = "/lab/tree/([^"]+)"', post).group(1)
+    assert sorted(p.stem for p in (ROOT / folder).glob("*.ipynb")) == LAB_PAGES
+    assert "-r ../requirements.txt" in (ROOT / "binder" / "requirements.txt").read_text()
+    assert re.search(r"(?m)^jupyterlab==\d", (ROOT / "requirements.txt").read_text())
+
+
+# --------------------------------------------------------------------------- livre construit
+
+
+@pytest.mark.book
+@pytest.mark.parametrize("page", LAB_PAGES)
+def test_built_lab_page_ran_its_solutions_and_offers_the_student_notebook(built_book, page):
+    """La construction exécute chaque TP avec ses solutions : toutes les vérifications sont vertes,
+    la figure de l'étudiant est tracée, et le carnet à compléter se télécharge."""
+    html = (built_book / "book" / f"{page}.html").read_text()
+    checks = len(re.findall(r"^practice\.check\(", _page(page), re.M))
+    assert html.count('class="kc-verdict kc-verdict-reussi"') == checks
+    assert "kc-verdict-a-corriger" not in html and "Fonction pas encore écrite" not in html
+    assert "Votre filtre n&#39;a pas pu tourner" not in html and "Votre filtre n'a pas pu tourner" not in html
+    link = re.search(rf'href="(\.\./_downloads/[0-9a-f]+/{page}\.ipynb)"', html)
+    assert link, f"{page} : pas de lien de téléchargement du carnet"
+    downloaded = (built_book / "book" / link.group(1)).resolve()
+    assert downloaded.read_bytes() == (BOOK / "travaux-pratiques" / f"{page}.ipynb").read_bytes()
+    assert 'class="solution dropdown' in html
