@@ -50,6 +50,17 @@ from .core.angles import wrap_angle
 from .core.jacobians import JacobianCheck, check_jacobian, numerical_jacobian
 from .filters.kalman import Prediction, Update, kalman_filter, kalman_filter_runs, predict, recipe_step, update
 from .core.models import LinearGaussianModel, NonlinearModel
+# temps continu, pistage : modèles de mouvement, IMM (issue 21)
+from .core.motion import (
+    constant_acceleration,
+    constant_acceleration_sde,
+    constant_velocity,
+    constant_velocity_model,
+    constant_velocity_sde,
+    coordinated_turn,
+    discretize,
+)
+from .filters.imm import IMMResult, imm_filter
 from .core.results import FilterResult, FilterRuns
 from .core.simulation import Simulation, simulate
 from .diagnostics.monte_carlo import ConsistencyRuns, MonteCarlo, monte_carlo, monte_carlo_consistency
@@ -256,6 +267,16 @@ __all__ = [
     "expectation_maximization",
     "likelihood",
     "datasets",
+    # temps continu et pistage (issue 21)
+    "discretize",
+    "constant_velocity",
+    "constant_acceleration",
+    "constant_velocity_sde",
+    "constant_acceleration_sde",
+    "constant_velocity_model",
+    "coordinated_turn",
+    "imm_filter",
+    "IMMResult",
     # sous-modules
     "errata",
     "figures",

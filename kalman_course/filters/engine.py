@@ -41,6 +41,7 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
+from ..core.models import model_steps
 from ..core.results import FilterHistory, FilterResult, FilterRuns
 from ..core.simulation import as_generator
 from ..core.validation import (
@@ -206,14 +207,16 @@ def run_filter(
     step_outputs = family.step_outputs
     xs, Ps, xps, Pps = out.x, out.P, out.x_pred, out.P_pred
     Ks, nus, Ss, n_iter = out.K, out.innovation, out.S, out.n_iter
+    steps = model_steps(model, T)  # modèle variable dans le temps : celui du pas k (model.at(k))
     for k in range(T):
-        predicted = predict(model, state, None if U is None else U[k])
+        mk = model if steps is None else steps[k]
+        predicted = predict(mk, state, None if U is None else U[k])
         if full[k]:
-            state, corr = update(model, predicted, Y[k], None)
+            state, corr = update(mk, predicted, Y[k], None)
             Ks[k], nus[k], Ss[k], n_iter[k] = corr
         elif some[k]:
             idx = np.flatnonzero(observed[k])
-            state, corr = update(model, predicted, Y[k, idx], idx)
+            state, corr = update(mk, predicted, Y[k, idx], idx)
             out.correction(k, corr, idx)
         else:
             state = predicted
@@ -277,10 +280,12 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
     Ss = np.full((N, T, m, m), np.nan)
     n_iter = np.zeros((N, T), dtype=int)
     full = observed.all(axis=2)  # (N, T)
+    steps = model_steps(model, T)  # modèle variable dans le temps : celui du pas k (model.at(k))
     for k in range(T):
-        predicted = family.predict_many(model, state, None if U is None else U[k], k)
+        mk = model if steps is None else steps[k]
+        predicted = family.predict_many(mk, state, None if U is None else U[k], k)
         if full[:, k].all():
-            state, corr = family.update_many(model, predicted, Yarr[:, k], None, k)
+            state, corr = family.update_many(mk, predicted, Yarr[:, k], None, k)
             Ks[:, k], nus[:, k], Ss[:, k], n_iter[:, k] = corr
         else:
             state = tuple(np.array(a) for a in predicted)
@@ -291,7 +296,7 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
                 runs = np.flatnonzero(group.ravel() == g)
                 idx = None if pattern.all() else np.flatnonzero(pattern)
                 y_g = Yarr[runs, k] if idx is None else Yarr[runs, k][:, idx]
-                new, corr = family.update_many(model, tuple(a[runs] for a in predicted), y_g, idx, k)
+                new, corr = family.update_many(mk, tuple(a[runs] for a in predicted), y_g, idx, k)
                 for a, b in zip(state, new):
                     a[runs] = b
                 _store_correction(Ks, nus, Ss, n_iter, runs, k, idx, corr)

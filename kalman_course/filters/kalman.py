@@ -15,7 +15,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.linalg import S_NOT_PD, correct, kalman_gain, symmetrize
-from ..core.models import LinearGaussianModel
+from ..core.models import LinearGaussianModel, model_steps
 from ..core.results import FilterResult, FilterRuns
 from ..core.validation import (
     as_batch_measurements,
@@ -31,6 +31,7 @@ from ..core.validation import (
     shape_text,
 )
 from .engine import Correction, FilterFamily, gaussian_moments, gaussian_prior, run_filter
+from .gating import fading_factor, gate_probability, gate_threshold, nis_value
 
 __all__ = [
     "Prediction", "Update", "predict", "update", "kalman_filter", "kalman_family", "kalman_filter_runs", "recipe_step",
@@ -84,7 +85,7 @@ def _control_term(model: LinearGaussianModel, u: Any) -> np.ndarray | None:
 # --------------------------------------------------------------------------- étapes publiques
 
 
-def predict(model: LinearGaussianModel, x: Any, P: Any, u: Any = None) -> Prediction:
+def predict(model: LinearGaussianModel, x: Any, P: Any, u: Any = None, *, fading: Any = None) -> Prediction:
     r"""Étape de prédiction (*time update*).
 
     .. math::
@@ -92,9 +93,14 @@ def predict(model: LinearGaussianModel, x: Any, P: Any, u: Any = None) -> Predic
         \hat x_{k\mid k-1} = A\,\hat x_{k-1\mid k-1} + B\,u_{k-1},\qquad
         P_{k\mid k-1} = A\,P_{k-1\mid k-1}A^T + Q
 
-    Paramètres : ``x`` (n,), ``P`` (n, n) symétrique semi-définie positive, ``u`` (p,) ou ``None``.
+    Paramètres : ``x`` (n,), ``P`` (n, n) symétrique semi-définie positive, ``u`` (p,) ou ``None`` ;
+    ``fading`` : facteur :math:`\alpha \ge 1` de mémoire évanescente, :math:`P_{k\mid k-1} = \alpha^2AP
+    A^T + Q` (:mod:`~kalman_course.filters.gating`). Modèle variable dans le temps : passez ``model.at(k)``.
     """
+    alpha2 = fading_factor(fading)
     x_arr, P_arr = _check_state(x, P, model.n_state, "x", "P")
+    if alpha2 is not None:
+        P_arr = alpha2 * P_arr
     x_pred, P_pred = _predict(x_arr, P_arr, model.A, model.Q, _control_term(model, u))
     return Prediction(x_pred, P_pred)
 
@@ -167,6 +173,9 @@ def kalman_filter(
     P0: Any,
     u: Any = None,
     joseph: bool = False,
+    *,
+    gate: Any = None,
+    fading: Any = None,
 ) -> FilterResult:
     r"""Filtre de Kalman sur toutes les mesures : pour chaque ``y[k]``, prédiction puis correction.
 
@@ -185,22 +194,37 @@ def kalman_filter(
     u : (T, p), ou (T,) si p = 1, optionnel — commandes (exige un modèle avec ``B``).
     joseph : bool — forme de Joseph pour la covariance a posteriori (``False`` par défaut : forme du
         cours ; voir :func:`update`).
+    gate : probabilité :math:`0 < p < 1`, optionnelle — **porte** : une mesure dont le NIS
+        :math:`\nu_k^TS_k^{-1}\nu_k` dépasse le quantile :math:`\chi^2_{m_k}(p)` (:math:`m_k` composantes
+        observées) est rejetée et le pas se réduit à la prédiction (:mod:`~kalman_course.filters.gating`).
+        Un pas rejeté garde son innovation et sa covariance ``S`` (son NIS se lit par
+        :func:`~kalman_course.nis`), avec un gain nul ; ``result.rejected`` (T,) marque ces pas.
+    fading : facteur :math:`\alpha \ge 1`, optionnel — **mémoire évanescente** :
+        :math:`P_{k\mid k-1} = \alpha^2 A P_{k-1\mid k-1}A^T + Q` (``KalmanFilter.alpha`` de filterpy).
+
+    ``model`` peut varier dans le temps (matrices (T, …), voir
+    :class:`~kalman_course.LinearGaussianModel`) : le pas ``k`` prédit avec :math:`A_k, Q_k` et corrige
+    avec :math:`C_k, R_k`.
 
     Renvoie
     -------
     FilterResult
         ``x`` (T, n), ``P`` (T, n, n), ``x_pred``, ``P_pred``, ``K`` (T, n, m), ``innovation`` (T, m),
-        ``S`` (T, m, m), ``observed`` (T, m).
+        ``S`` (T, m, m), ``observed`` (T, m), ``rejected`` (T,).
     """
-    return run_filter(kalman_family(joseph), model, y, x0, P0, u)
+    return run_filter(kalman_family(joseph, gate=gate, fading=fading), model, y, x0, P0, u)
 
 
-def kalman_family(joseph: bool = False) -> FilterFamily:
+def kalman_family(joseph: bool = False, *, gate: Any = None, fading: Any = None) -> FilterFamily:
     r"""Les étapes du filtre de Kalman linéaire pour le moteur :func:`~kalman_course.filters.engine.run_filter`
-    (état interne :math:`(\hat x, P)`)."""
+    (état interne :math:`(\hat x, P)`) ; ``gate`` et ``fading`` : voir :func:`kalman_filter`."""
+    p_gate = gate_probability(gate)
+    alpha2 = fading_factor(fading)
 
     def predict_step(model: LinearGaussianModel, state, u):
         x, P = state
+        if alpha2 is not None:
+            P = alpha2 * P
         return _predict(x, P, model.A, model.Q, None if u is None else model.B.dot(u))
 
     def update_step(model: LinearGaussianModel, state, y, idx):
@@ -210,6 +234,10 @@ def kalman_family(joseph: bool = False) -> FilterFamily:
         else:
             C, R = model.C[idx], model.R[np.ix_(idx, idx)]
         nu = y - C.dot(x_pred)
+        if p_gate is not None:
+            S = C.dot(P_pred).dot(C.T) + R
+            if nis_value(nu, S) > gate_threshold(p_gate, len(nu)):  # rejetée : prédiction seule
+                return state, Correction(np.zeros((len(x_pred), len(nu))), nu, S, 0)
         x, P, K, S = correct(x_pred, P_pred, nu, C, R, joseph)
         return (x, P), Correction(K, nu, S)
 
@@ -262,6 +290,7 @@ def kalman_filter_runs(
     N, T, _ = Yarr.shape
     X0 = as_batch_vector("x0", x0, n, N)
     P = check_psd("P0", as_square_matrix("P0", P0, n))
+    steps = model_steps(model, T)  # modèle variable dans le temps : les matrices du pas k
     BU = _batch_controls(model, u, N, T)  # None, (T, n) ou (N, T, n)
     observed = ~np.isnan(Yarr)
     A, C, Q, R = model.A, model.C, model.Q, model.R
@@ -272,6 +301,8 @@ def kalman_filter_runs(
     if observed.all():
         Ps, Pps, Ks, Ss = np.empty((T, n, n)), np.empty((T, n, n)), np.empty((T, n, m)), np.empty((T, m, m))
         for k in range(T):
+            if steps is not None:
+                A, C, Q, R = steps[k].A, steps[k].C, steps[k].Q, steps[k].R
             Xp = X.dot(A.T)
             if BU is not None:
                 Xp += BU[..., k, :]
@@ -295,6 +326,8 @@ def kalman_filter_runs(
     n_iter = np.zeros((N, T), dtype=int)
     Pr = np.broadcast_to(P, (N, n, n)).copy()
     for k in range(T):
+        if steps is not None:
+            A, C, Q, R = steps[k].A, steps[k].C, steps[k].Q, steps[k].R
         Xp = X.dot(A.T)
         if BU is not None:
             Xp += BU[..., k, :]
@@ -346,6 +379,11 @@ def _batch_controls(model: LinearGaussianModel, u: Any, N: int, T: int) -> np.nd
     U = as_float_array("u", u)
     if U.ndim == 1 and p == 1:
         U = U[:, None]
+    if model.B.ndim == 3:  # commande variable dans le temps : B_k u_k
+        if U.ndim == 2 and U.shape == (T, p):
+            return np.einsum("tij,tj->ti", model.B, U)
+        if U.ndim == 3 and U.shape == (N, T, p):
+            return np.einsum("tij,ntj->nti", model.B, U)
     if U.ndim == 2 and U.shape == (T, p):
         return U @ model.B.T
     if U.ndim == 3 and U.shape == (N, T, p):
