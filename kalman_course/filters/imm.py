@@ -31,8 +31,9 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple, Sequence
 
 import numpy as np
+import scipy.linalg
 
-from ..core.linalg import symmetrize
+from ..core.linalg import S_NOT_PD, symmetrize
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult
 from ..core.validation import (
@@ -50,6 +51,7 @@ from .kalman import kalman_family
 __all__ = ["ModeSet", "IMMState", "IMMResult", "imm_family", "imm_filter", "mode_mixing"]
 
 LOG_2PI = float(np.log(2.0 * np.pi))
+_posv = scipy.linalg.get_lapack_funcs("posv", dtype=np.float64)
 
 
 @dataclass(frozen=True, eq=False, init=False)
@@ -219,11 +221,16 @@ def mode_mixing(transition: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.
     return cbar, W / cbar
 
 
+def _weighted(w: np.ndarray, M: np.ndarray) -> np.ndarray:
+    r""":math:`\sum_j w_jM_j` pour une pile ``M`` (r, a, b) (un produit matrice–vecteur, sans ``tensordot``)."""
+    return w.dot(M.reshape(len(w), -1)).reshape(M.shape[1:])
+
+
 def _combine(w: np.ndarray, X: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     r""":math:`\hat x = \sum_j w_jx_j` et :math:`\sum_j w_j[P_j + (x_j - \hat x)(x_j - \hat x)^T]`."""
     x = w.dot(X)
     D = X - x
-    return x, symmetrize(np.tensordot(w, P, axes=1) + (D.T * w).dot(D))
+    return x, symmetrize(_weighted(w, P) + (D.T * w).dot(D))
 
 
 def imm_family() -> FilterFamily:
@@ -273,10 +280,12 @@ def imm_family() -> FilterFamily:
             Ss.append(corr.S)
             PCts.append(corr.K.dot(corr.S))                           # P⁻_j C_jᵀ = K_j S_j
         nu, S = np.array(nus), np.array(Ss)                           # (r, m_k), (r, m_k, m_k)
-        L = np.linalg.cholesky(S)
-        w = np.linalg.solve(L, nu[:, :, None])[:, :, 0]
-        log_l = -0.5 * (nu.shape[1] * LOG_2PI + np.sum(w * w, axis=1)) \
-            - np.sum(np.log(np.diagonal(L, axis1=1, axis2=2)), axis=1)
+        log_l = np.empty(r)
+        for j in range(r):  # log N(ν_j ; 0, S_j) : un appel LAPACK (Cholesky et résolution) par régime
+            factor, Sinv_nu, info = _posv(Ss[j], nus[j])
+            if info != 0:
+                raise KalmanInputError(f"{S_NOT_PD[:-1]} (régime {j}).")
+            log_l[j] = -0.5 * (len(nus[j]) * LOG_2PI + nus[j].dot(Sinv_nu)) - np.log(np.diagonal(factor)).sum()
         cbar = state.mu
         with np.errstate(divide="ignore"):
             a = np.log(cbar) + log_l
@@ -285,9 +294,9 @@ def imm_family() -> FilterFamily:
         # la correction vue du moteur : celle de la loi gaussienne de mêmes moments que le mélange prédit
         nu_mix = cbar.dot(nu)
         E = nu - nu_mix                                                # ŷ_j − ŷ = −(ν_j − ν)
-        S_mix = symmetrize(np.tensordot(cbar, S, axes=1) + (E.T * cbar).dot(E))
+        S_mix = symmetrize(_weighted(cbar, S) + (E.T * cbar).dot(E))
         x_pred = cbar.dot(state.X)
-        Pxy = np.tensordot(cbar, np.array(PCts), axes=1) - ((state.X - x_pred).T * cbar).dot(E)
+        Pxy = _weighted(cbar, np.array(PCts)) - ((state.X - x_pred).T * cbar).dot(E)
         K = np.linalg.solve(S_mix, Pxy.T).T
         return IMMState(X, P, mu, cbar), Correction(K, nu_mix, S_mix)
 
