@@ -60,6 +60,7 @@ from .core.motion import (
     coordinated_turn,
     discretize,
 )
+from .filters.adaptive import AdaptiveResult, adaptive_kalman_filter
 from .filters.imm import IMMResult, imm_filter
 from .core.results import FilterResult, FilterRuns
 from .core.simulation import Simulation, simulate
@@ -277,6 +278,8 @@ __all__ = [
     "coordinated_turn",
     "imm_filter",
     "IMMResult",
+    "adaptive_kalman_filter",
+    "AdaptiveResult",
     # sous-modules
     "errata",
     "figures",

@@ -102,8 +102,8 @@ class LinearGaussianModel:
         m = C_arr.shape[-2]
         if C_arr.ndim == 3 and len({c.shape for c in C_arr}) > 1:  # pragma: no cover (tableau rectangulaire)
             raise KalmanInputError("« C » : toutes les lignes doivent avoir la même forme.")
-        Q_arr = _each_step("Q", Q, T, lambda name, q: check_psd(name, as_square_matrix(name, q, n)))
-        R_arr = _each_step("R", R, T, lambda name, r: check_pd(name, as_square_matrix(name, r, m)))
+        Q_arr = _each_step("Q", Q, T, lambda name, q: check_psd(name, as_square_matrix(name, q, n)), "psd")
+        R_arr = _each_step("R", R, T, lambda name, r: check_pd(name, as_square_matrix(name, r, m)), "pd")
         B_arr = None
         if B is not None:
 
@@ -217,13 +217,44 @@ def _time_axis(matrices: dict[str, Any]) -> int | None:
     return T
 
 
-def _each_step(name: str, value: Any, T: int | None, check: Callable[[str, Any], np.ndarray]) -> np.ndarray:
-    """Vérifie une matrice constante, ou chaque ligne ``name[k]`` d'une pile (T, …) ; renvoie le tableau."""
+def _each_step(name: str, value: Any, T: int | None, check: Callable[[str, Any], np.ndarray],
+               covariance: str | None = None) -> np.ndarray:
+    """Vérifie une matrice constante, ou chaque ligne ``name[k]`` d'une pile (T, …) ; renvoie le tableau.
+
+    Pile de covariances (``covariance`` = ``"psd"`` ou ``"pd"``) : la forme est vérifiée sur la première
+    ligne, symétrie et positivité sur toutes à la fois (mêmes tolérances que
+    :func:`~kalman_course.core.validation.check_psd`, :func:`~kalman_course.core.validation.check_pd`) ;
+    la première ligne fautive est ensuite vérifiée seule, pour son message d'erreur."""
     if value is None or np.ndim(value) != 3:
         return check(name, value)
     arr = as_float_array(name, value)
-    rows = [check(f"{name}[{k}]", arr[k]) for k in range(T)]
-    return np.array(rows)
+    if covariance is None:
+        return np.array([check(f"{name}[{k}]", arr[k]) for k in range(T)])
+    check(f"{name}[0]", arr[0])  # forme (et première ligne)
+    scale = np.maximum(1.0, np.abs(arr).max(axis=(1, 2)))
+    asym = np.abs(arr - np.swapaxes(arr, 1, 2)).max(axis=(1, 2))
+    sym = 0.5 * (arr + np.swapaxes(arr, 1, 2))
+    ok = asym <= 1e-9 * scale
+    if ok.all():
+        if covariance == "psd":
+            ok = np.linalg.eigvalsh(sym)[:, 0] >= -1e-10 * scale
+        else:
+            try:
+                np.linalg.cholesky(sym)
+            except np.linalg.LinAlgError:
+                ok = np.array([_is_pd(M) for M in sym])
+    if not ok.all():
+        k = int(np.argmin(ok))
+        check(f"{name}[{k}]", arr[k])  # lève l'erreur française de cette ligne
+    return sym
+
+
+def _is_pd(M: np.ndarray) -> bool:
+    try:
+        np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        return False
+    return True
 
 
 def _constant_model(A, C, Q, R, B) -> LinearGaussianModel:

@@ -131,16 +131,13 @@ def discretize(F: Any, L: Any, Qc: Any, dt: Any) -> Discretized:
     M[:n, :n] = -F_arr
     M[:n, n:] = G
     M[n:, n:] = F_arr.T
-    As, Qs = [], []
-    for h in np.atleast_1d(steps):
-        E = scipy.linalg.expm(M * h)
-        A = E[n:, n:].T
-        Q = A @ E[:n, n:]
-        As.append(A)
-        Qs.append(0.5 * (Q + Q.T))
+    E = scipy.linalg.expm(M * np.atleast_1d(steps)[:, None, None])  # une exponentielle par pas, en lot
+    A = np.swapaxes(E[:, n:, n:], 1, 2)
+    Q = A @ E[:, :n, n:]
+    Q = 0.5 * (Q + np.swapaxes(Q, 1, 2))
     if steps.ndim == 0:
-        return Discretized(As[0], Qs[0])
-    return Discretized(np.array(As), np.array(Qs))
+        return Discretized(A[0], Q[0])
+    return Discretized(A, Q)
 
 
 def _dimension(dim: Any) -> int:
