@@ -224,7 +224,10 @@ class GateStudy:
     (sur :data:`OUTLIER_ROWS`) ; ``other_rejected`` : autres positions rejetées dans cette expérience ;
     ``deviation_plain``, ``deviation_gated`` : plus grand écart de position (m) à l'estimation sur données
     propres, sans et avec la porte ; ``lost_at_99`` : instant de perte de la piste avec :math:`p = 0{,}99`
-    (ou ``None``) ; ``lost_at_quiet`` : avec :math:`p = 0{,}999` et une densité 100 fois trop petite."""
+    (ou ``None``), ``regained_99`` : instant de la première position de nouveau acceptée ;
+    ``lost_at_quiet`` : avec :math:`p = 0{,}999` et une densité 100 fois trop petite, ``quiet_rejected`` :
+    part des positions alors rejetées après la perte, ``quiet_final_error`` : écart (m) entre la dernière
+    estimation et la dernière position."""
 
     exceed_99: float
     exceed_999: float
@@ -234,7 +237,10 @@ class GateStudy:
     deviation_plain: float
     deviation_gated: float
     lost_at_99: float | None
+    regained_99: float | None
     lost_at_quiet: float | None
+    quiet_rejected: float
+    quiet_final_error: float
 
 
 @lru_cache(maxsize=1)
@@ -253,6 +259,15 @@ def gate_study() -> GateStudy:
     rejected = np.flatnonzero(gated_bad.rejected)
     deviation = lambda r: float(np.max(np.hypot(*(r.x[:, :2] - clean.x[:, :2]).T)))  # noqa: E731
     q, sp = fitted_parameters("position")
+    t = np.asarray(track.t)
+    loose = helicopter_filter("position", gate=0.99)
+    lost_at = lost_track_time(loose, track)
+    regained = None
+    if lost_at is not None:
+        after = np.flatnonzero((t > lost_at) & ~np.asarray(loose.rejected))
+        regained = float(t[after[0]]) if after.size else None
+    quiet = helicopter_filter("position", q / 100.0, sp, gate=0.999)
+    lost_quiet = lost_track_time(quiet, track)
     return GateStudy(
         exceed_99=float(np.mean(e > gate_threshold(0.99, 2))),
         exceed_999=float(np.mean(e > gate_threshold(0.999, 2))),
@@ -261,6 +276,9 @@ def gate_study() -> GateStudy:
         other_rejected=int((~np.isin(rejected, bad_rows)).sum()),
         deviation_plain=deviation(plain_bad),
         deviation_gated=deviation(gated_bad),
-        lost_at_99=lost_track_time(helicopter_filter("position", gate=0.99), track),
-        lost_at_quiet=lost_track_time(helicopter_filter("position", q / 100.0, sp, gate=0.999), track),
+        lost_at_99=lost_at,
+        regained_99=regained,
+        lost_at_quiet=lost_quiet,
+        quiet_rejected=float(np.mean(quiet.rejected[t >= lost_quiet])) if lost_quiet is not None else 0.0,
+        quiet_final_error=float(np.hypot(*(quiet.x[-1, :2] - np.asarray(track.y)[-1, :2]))),
     )
