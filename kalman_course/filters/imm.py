@@ -40,6 +40,7 @@ from ..core.validation import (
     KalmanInputError,
     as_float_array,
     as_square_matrix,
+    as_vector,
     check_instance,
     check_psd,
     number_text,
@@ -242,13 +243,10 @@ def imm_family() -> FilterFamily:
     def prior(model: ModeSet, x0, P0) -> IMMState:
         r, n = model.n_modes, model.n_state
         X = as_float_array("x0", x0)
-        if X.ndim == 0 and n == 1:
-            X = X.reshape(1)
-        if X.shape == (n,):
-            X = np.tile(X, (r, 1))
-        elif X.shape != (r, n):
-            raise KalmanInputError(f"« x0 » doit être de forme ({n},) (commun) ou ({r}, {n}) (un par régime) ; "
-                                   f"reçu {shape_text(X.shape)}.")
+        if X.ndim == 2 and X.shape == (r, n) and r > 1:  # un a priori par régime
+            X = X.copy()
+        else:  # commun : les vérifications (et messages) de tous les filtres
+            X = np.tile(as_vector("x0", x0, n), (r, 1))
         P = as_float_array("P0", P0)
         if P.ndim == 3:
             if P.shape != (r, n, n):
