@@ -170,7 +170,9 @@ def run_filter(
 
     Paramètres
     ----------
-    model : le modèle de la famille (vérifié).
+    model : le modèle de la famille (vérifié). Un modèle variable dans le temps (``model.time_varying``,
+        par exemple un :class:`~kalman_course.LinearGaussianModel` à matrices (T, …)) : les étapes du pas
+        ``k`` reçoivent son modèle constant ``model.at(k)``.
     y : (T, m), ou (T,) si m = 1 — ``None`` ou ``NaN`` : mesure manquante (prédiction seule) ; une ligne
         partiellement manquante n'utilise que ses composantes observées.
     x0, P0 : a priori, vérifiés et convertis par ``family.prior``.
