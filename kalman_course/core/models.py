@@ -100,8 +100,6 @@ class LinearGaussianModel:
 
         C_arr = _each_step("C", C, T, observation)
         m = C_arr.shape[-2]
-        if C_arr.ndim == 3 and len({c.shape for c in C_arr}) > 1:  # pragma: no cover (tableau rectangulaire)
-            raise KalmanInputError("« C » : toutes les lignes doivent avoir la même forme.")
         Q_arr = _each_step("Q", Q, T, lambda name, q: check_psd(name, as_square_matrix(name, q, n)), "psd")
         R_arr = _each_step("R", R, T, lambda name, r: check_pd(name, as_square_matrix(name, r, m)), "pd")
         B_arr = None
