@@ -166,3 +166,68 @@ def test_imm_probability_follows_the_helicopter_turns():
     assert h.correlation > 0.6
     assert h.prediction_rms < h.prediction_rms_single * 1.05
     assert np.allclose(h.result.mu.sum(axis=1), 1.0)
+
+
+# --------------------------------------------------------------------------- curseurs, contre filterpy
+
+
+def test_gate_slider_grid_equals_filterpy_with_a_hand_written_gate():
+    """Quelques points de la grille des curseurs de la porte : filterpy pas à pas (predict(F=A[k], Q=Q[k]),
+    NIS calculé ici, update sauté au-delà du quantile de scipy.stats)."""
+    from filterpy.kalman import KalmanFilter
+
+    import kalman_course.interactive as ki
+    from kalman_course.interactive import tracking
+
+    grid = ki.slider_grid("capteurs-porte-curseurs")
+    track = heli.helicopter_track("position")
+    y = heli.with_outliers(track)
+    sp = heli.fitted_parameters("position")[1]
+    for index in [(1, 4), (2, 4), (2, 1), (4, 4)]:
+        gate, q = grid.values_at(*index)
+        A, Q = kc.constant_velocity(track.dt, q, dim=2)
+        f = KalmanFilter(dim_x=4, dim_z=2)
+        f.H, f.R = np.eye(4)[:2], sp**2 * np.eye(2)
+        f.x, f.P = np.asarray(track.x0).reshape(4, 1), np.array(track.P0)
+        xs, rejected = [], 0
+        for k in range(len(y)):
+            f.predict(F=A[k], Q=Q[k])
+            nu = y[k].reshape(2, 1) - f.H @ f.x
+            S = f.H @ f.P @ f.H.T + f.R
+            if gate < 1.0 and (nu.T @ np.linalg.solve(S, nu)).item() > scipy.stats.chi2.ppf(gate, 2):
+                rejected += 1
+            else:
+                f.update(y[k].reshape(2, 1))
+            xs.append(f.x.ravel().copy())
+        run = grid.run(*index)
+        xs = np.array(xs)
+        assert int(run["n_rejected"][0]) == rejected, index
+        assert np.allclose(run["est_e"] * 1e3, xs[:, 0], rtol=1e-9, atol=1e-6), index
+        assert np.allclose(run["est_n"] * 1e3, xs[:, 1], rtol=1e-9, atol=1e-6), index
+    assert tracking.GATES[grid.default_index[0]] == 0.999
+
+
+def test_imm_slider_grid_equals_filterpy_immestimator():
+    from filterpy.kalman import IMMEstimator, KalmanFilter
+
+    import kalman_course.interactive as ki
+
+    grid = ki.slider_grid("manoeuvre-imm-curseurs")
+    st = man.manoeuvre_study()
+    for index in [grid.default_index, (0, 0, 3), (3, 2, 0)]:
+        switch, q1, q2 = grid.values_at(*index)
+        filters = []
+        for q in (q1, q2):
+            model = man.cv_model(q)
+            f = KalmanFilter(dim_x=4, dim_z=2)
+            f.F, f.H, f.Q, f.R = (np.array(a) for a in (model.A, model.C, model.Q, model.R))
+            f.x, f.P = man.X0.reshape(4, 1).copy(), man.P0.copy()
+            filters.append(f)
+        imm = IMMEstimator(filters, np.array([1 - switch, switch]),
+                           np.array([[1 - switch, switch], [switch, 1 - switch]]))
+        mus = []
+        for z in st.y:
+            imm.predict()
+            imm.update(z.reshape(2, 1))
+            mus.append(imm.mu[1])
+        assert np.allclose(grid.run(*index)["mu"], mus, rtol=1e-9, atol=1e-12), index
