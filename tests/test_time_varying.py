@@ -249,3 +249,18 @@ def test_at_gives_the_constant_model_of_a_step():
     assert not step.time_varying and np.array_equal(step.A, A[2]) and np.array_equal(step.Q, Q[2])
     with pytest.raises(kc.KalmanInputError, match="indice de pas"):
         model.at(3)
+
+
+def test_diffuse_likelihood_of_a_stacked_constant_model_is_the_constant_one():
+    """Départ diffus exact (sans a priori) : un modèle constant écrit en pile (T, ·, ·) donne la même
+    vraisemblance que le modèle constant ; un vrai modèle variable est accepté aussi."""
+    rng = np.random.default_rng(12)
+    A, Q = kc.constant_velocity(1.0, 0.4, dim=1)
+    const = kc.LinearGaussianModel(A, [[1.0, 0.0]], Q, [[2.0]])
+    y = np.array(kc.simulate(const, [0.0, 1.0], 30, rng=rng).y)
+    y[5] = np.nan
+    stacked = kc.LinearGaussianModel(np.repeat(A[None], 30, 0), [[1.0, 0.0]], np.repeat(Q[None], 30, 0), [[2.0]])
+    assert kc.log_likelihood(stacked, y) == pytest.approx(kc.log_likelihood(const, y), rel=1e-11)
+    A2, Q2 = kc.constant_velocity(rng.uniform(0.5, 2.0, 30), 0.4, dim=1)
+    varying = kc.LinearGaussianModel(A2, [[1.0, 0.0]], Q2, [[2.0]])
+    assert np.isfinite(kc.log_likelihood(varying, y))
