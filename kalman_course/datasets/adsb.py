@@ -104,8 +104,7 @@ class Flight:
         return float(np.rad2deg(np.abs(np.diff(heading)).sum()))
 
     def __repr__(self) -> str:
-        return (f"<Vol {self.name} : {len(self)} positions sur {self.duration:.0f} s, "
-                f"{self.velocity_t.size} vitesses, début {self.start_utc}>")
+        return f"<Vol {self.name} : {len(self)} positions, {self.velocity_t.size} vitesses, {self.duration:.0f} s>"
 
 
 def enu_from_geodetic(lat_deg, lon_deg, lat0_deg: float, lon0_deg: float) -> tuple[np.ndarray, np.ndarray]:

@@ -110,7 +110,7 @@ def gate_spec() -> SliderSpec:
         run=gate_run,
         time=np.asarray(track.t),
         panels=(
-            Panel("Dans le plan : estimation et ellipses à 2σ (une sur six)", "nord (km)", (
+            Panel("Estimation, ellipses à 2σ (une sur six)", "nord (km)", (
                 Glyph("meas_n", "scatter", "gray", "positions mesurées", x="meas_e", marker="cross", size=5),
                 Glyph("out_n", "scatter", "crimson", "positions aberrantes", x="out_e", marker="x", size=11),
                 Glyph("ell_n", "line", "royalblue", "ellipses à 2σ", x="ell_e", width=1.0, alpha=0.7),
@@ -218,11 +218,11 @@ MANOEUVRE_DENSITIES = (2.0, 20.0, 200.0, 2000.0)
 def imm_axes() -> tuple[ParameterAxis, ParameterAxis, ParameterAxis]:
     """Probabilité de changer de régime, densité du régime calme, densité du régime agité."""
     return (
-        ParameterAxis("switch", "π", "probabilité de changer de régime", "", np.array(SWITCHES),
+        ParameterAxis("switch", "π", "changement de régime", "", np.array(SWITCHES),
                       default=SWITCHES.index(man.SWITCH)),
-        ParameterAxis("q_quiet", "q₁", "densité du régime calme", "m²/s³", np.array(QUIET_DENSITIES),
+        ParameterAxis("q_quiet", "q₁", "régime calme", "m²/s³", np.array(QUIET_DENSITIES),
                       default=QUIET_DENSITIES.index(man.Q_QUIET)),
-        ParameterAxis("q_manoeuvre", "q₂", "densité du régime agité", "m²/s³", np.array(MANOEUVRE_DENSITIES),
+        ParameterAxis("q_manoeuvre", "q₂", "régime agité", "m²/s³", np.array(MANOEUVRE_DENSITIES),
                       default=MANOEUVRE_DENSITIES.index(man.Q_MANOEUVRE)),
     )
 
