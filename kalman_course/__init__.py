@@ -45,6 +45,18 @@ from .filters.iterated import (
     map_cost,
 )
 from .filters.kalman import Prediction, Update, kalman_filter, kalman_filter_runs, predict, recipe_step, update
+# temps continu, pistage : modèles de mouvement, filtre à Q adaptative, IMM
+from .core.motion import (
+    constant_acceleration,
+    constant_acceleration_sde,
+    constant_velocity,
+    constant_velocity_model,
+    constant_velocity_sde,
+    coordinated_turn,
+    discretize,
+)
+from .filters.adaptive import AdaptiveResult, adaptive_kalman_filter
+from .filters.imm import IMMResult, imm_filter
 from .filters.particle import (
     RESAMPLING_SCHEMES,
     ParticleFilterResult,
@@ -244,6 +256,18 @@ __all__ = [
     "maximum_likelihood",
     "EMResult",
     "expectation_maximization",
+    # temps continu et pistage
+    "discretize",
+    "constant_velocity",
+    "constant_acceleration",
+    "constant_velocity_sde",
+    "constant_acceleration_sde",
+    "constant_velocity_model",
+    "coordinated_turn",
+    "imm_filter",
+    "IMMResult",
+    "adaptive_kalman_filter",
+    "AdaptiveResult",
     # sous-modules
     "errata",
     "geometry",

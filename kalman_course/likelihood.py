@@ -289,7 +289,8 @@ def log_likelihoods(models: Any, y: Any) -> np.ndarray:
     Y = as_measurements("y", y, m)
     obs = ~np.isnan(Y)
     full, some = obs.all(axis=1), obs.any(axis=1)
-    if (some & ~full).any():  # lignes partielles : le calcul modèle par modèle
+    if (some & ~full).any() or any(model.time_varying for model in models):
+        # lignes partielles ou modèles variables dans le temps : le calcul modèle par modèle
         return np.array([log_likelihood(model, Y) for model in models])
     A = np.stack([model.A for model in models])
     C = np.stack([model.C for model in models])
@@ -704,6 +705,12 @@ def expectation_maximization(
     Renvoie un :class:`EMResult`.
     """
     check_instance("model", model, LinearGaussianModel, "EM estime Q et R d'un modèle linéaire gaussien")
+    if model.time_varying:
+        raise KalmanInputError(
+            "« model » varie dans le temps : EM estime une seule paire (Q, R) constante et n'accepte qu'un "
+            "modèle constant (pour des pas irréguliers, estimez plutôt la densité du bruit par "
+            "maximum_likelihood)."
+        )
     if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
         raise KalmanInputError(f"« max_iter » doit être un entier ≥ 1 ; reçu {max_iter!r}.")
     tol_arr = as_float_array("tol", tol)

@@ -40,6 +40,12 @@ def _nonlinear(model):
     return kc.NonlinearModel.from_linear(model)
 
 
+def _stacked(model, T):
+    """Le même modèle écrit comme un modèle variable dans le temps (T copies de chaque matrice)."""
+    rep = lambda a: None if a is None else np.repeat(np.asarray(a)[None], T, axis=0)  # noqa: E731
+    return kc.LinearGaussianModel(rep(model.A), rep(model.C), rep(model.Q), rep(model.R), B=rep(model.B))
+
+
 def _ukf(model, y, x0, P0, u=None):
     return kc.unscented_kalman_filter(_nonlinear(model), y, x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0)
 
@@ -68,6 +74,16 @@ FILTERS = [
         _nonlinear(m), np.asarray(y)[None], x0, P0, u).run(0)),
     Member("UKF en lot", lambda m, y, x0, P0, u=None: unscented_kalman_filter_runs(
         _nonlinear(m), np.asarray(y)[None], x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0).run(0)),
+]
+# pistage (issue 21) : options et filtres qui redeviennent le filtre de Kalman
+FILTERS += [
+    Member("KF variable dans le temps (pile constante)", lambda m, y, x0, P0, u=None: kc.kalman_filter(
+        _stacked(m, max(len(y), 1)), y, x0, P0, u)),
+    Member("KF à porte (p = 1 − 10⁻¹²)", lambda m, y, x0, P0, u=None: kc.kalman_filter(
+        m, y, x0, P0, u, gate=1 - 1e-12)),
+    Member("IMM (un régime)", lambda m, y, x0, P0, u=None: kc.imm_filter([m], y, x0, P0, transition=[[1.0]], u=u)),
+    Member("Q adaptative (test jamais échoué)", lambda m, y, x0, P0, u=None: kc.adaptive_kalman_filter(
+        m, y, x0, P0, u, detect=1 - 1e-12)),
 ]
 IDS = [f.name for f in FILTERS]
 

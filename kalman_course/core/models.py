@@ -35,7 +35,7 @@ from .validation import (
     check_psd,
 )
 
-__all__ = ["LinearGaussianModel", "NonlinearModel"]
+__all__ = ["LinearGaussianModel", "NonlinearModel", "model_steps"]
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -56,16 +56,26 @@ class LinearGaussianModel:
 
     Paramètres
     ----------
-    A : (n, n)
+    A : (n, n) ou (T, n, n)
         Matrice d'état (``F`` dans filterpy). Un scalaire donne un modèle à un état.
-    C : (m, n)
+    C : (m, n) ou (T, m, n)
         Matrice d'observation (``H`` dans filterpy). Scalaire accepté si ``n = m = 1``.
-    Q : (n, n)
+    Q : (n, n) ou (T, n, n)
         Covariance du bruit d'état, symétrique semi-définie positive (peut être nulle).
-    R : (m, m)
+    R : (m, m) ou (T, m, m)
         Covariance du bruit de mesure, symétrique **définie** positive.
-    B : (n, p), optionnel
+    B : (n, p) ou (T, n, p), optionnel
         Matrice de commande ; sans elle, le modèle n'accepte pas de commande ``u``.
+
+    **Modèle variable dans le temps.** N'importe lesquelles de ces matrices peuvent porter un axe des
+    temps en tête, de même longueur ``T`` (les autres restent constantes) : la ligne ``k`` sert au pas
+    qui mène à la mesure ``y[k]``, :math:`x_k = A_k x_{k-1} + B_k u_k + \phi_k`,
+    :math:`\phi_k \sim \mathcal N(0, Q_k)`, :math:`y_k = C_k x_k + \psi_k`,
+    :math:`\psi_k \sim \mathcal N(0, R_k)` — exactement ``predict(F=A[k], Q=Q[k])`` puis
+    ``update(y[k], R=R[k], H=C[k])`` de filterpy. C'est ainsi qu'on filtre des mesures à instants
+    irréguliers (une discrétisation par pas, :func:`~kalman_course.core.motion.discretize`). Un tel
+    modèle ne filtre que des séries de ``T`` mesures (:attr:`n_steps`) ; :meth:`at` donne le modèle
+    constant du pas ``k``.
 
     Les tableaux sont copiés et rendus non modifiables : un modèle ne change pas après sa construction.
     """
@@ -77,47 +87,111 @@ class LinearGaussianModel:
     B: np.ndarray | None
 
     def __init__(self, A: Any, C: Any, Q: Any, R: Any, B: Any = None) -> None:
-        A_arr = as_square_matrix("A", A, None)
-        n = A_arr.shape[0]
-        C_arr = as_float_array("C", C)
-        if C_arr.ndim == 1:
-            raise KalmanInputError(
-                f"« C » doit être une matrice 2-D de forme (m, {n}) ; reçu un vecteur de forme {C_arr.shape}. "
-                f"Pour une seule mesure, écrivez C = [[…]] (une ligne)."
-            )
-        C_arr = as_matrix("C", C_arr, None, n)
-        m = C_arr.shape[0]
-        Q_arr = check_psd("Q", as_square_matrix("Q", Q, n))
-        R_arr = check_pd("R", as_square_matrix("R", R, m))
+        T = _time_axis({"A": A, "C": C, "Q": Q, "R": R, "B": B})
+        A_arr = _each_step("A", A, T, lambda name, a: as_square_matrix(name, a, None))
+        n = A_arr.shape[-1]
+
+        def observation(name, c):
+            c = as_float_array(name, c)
+            if c.ndim == 1:
+                raise KalmanInputError(
+                    f"« {name} » doit être une matrice 2-D de forme (m, {n}) ; reçu un vecteur de forme {c.shape}. "
+                    f"Pour une seule mesure, écrivez C = [[…]] (une ligne)."
+                )
+            return as_matrix(name, c, None, n)
+
+        C_arr = _each_step("C", C, T, observation)
+        m = C_arr.shape[-2]
+        Q_arr = _each_step("Q", Q, T, lambda name, q: check_psd(name, as_square_matrix(name, q, n)), "psd")
+        R_arr = _each_step("R", R, T, lambda name, r: check_pd(name, as_square_matrix(name, r, m)), "pd")
         B_arr = None
         if B is not None:
-            B_raw = as_float_array("B", B)
-            if B_raw.ndim == 1:
-                raise KalmanInputError(
-                    f"« B » doit être une matrice 2-D de forme ({n}, p) ; reçu un vecteur de forme {B_raw.shape}. "
-                    f"Pour une seule commande, écrivez B = [[…], …] (une colonne)."
-                )
-            B_arr = _readonly(as_matrix("B", B_raw, n, None))
+
+            def control(name, b):
+                b = as_float_array(name, b)
+                if b.ndim == 1:
+                    raise KalmanInputError(
+                        f"« {name} » doit être une matrice 2-D de forme ({n}, p) ; reçu un vecteur de forme {b.shape}. "
+                        f"Pour une seule commande, écrivez B = [[…], …] (une colonne)."
+                    )
+                return as_matrix(name, b, n, None)
+
+            B_arr = _readonly(_each_step("B", B, T, control))
         object.__setattr__(self, "A", _readonly(A_arr))
         object.__setattr__(self, "C", _readonly(C_arr))
         object.__setattr__(self, "Q", _readonly(Q_arr))
         object.__setattr__(self, "R", _readonly(R_arr))
         object.__setattr__(self, "B", B_arr)
+        object.__setattr__(self, "_n_steps", T)
+        object.__setattr__(self, "_steps", None)
 
     @property
     def n_state(self) -> int:
         """Dimension ``n`` de l'état."""
-        return self.A.shape[0]
+        return self.A.shape[-1]
 
     @property
     def n_obs(self) -> int:
         """Dimension ``m`` de la mesure."""
-        return self.C.shape[0]
+        return self.C.shape[-2]
 
     @property
     def n_control(self) -> int:
         """Dimension ``p`` de la commande (0 sans matrice ``B``)."""
-        return 0 if self.B is None else self.B.shape[1]
+        return 0 if self.B is None else self.B.shape[-1]
+
+    @property
+    def time_varying(self) -> bool:
+        """``True`` si au moins une matrice porte un axe des temps (modèle variable dans le temps)."""
+        return self._n_steps is not None
+
+    @property
+    def n_steps(self) -> int | None:
+        """Longueur ``T`` de l'axe des temps d'un modèle variable (``None`` pour un modèle constant)."""
+        return self._n_steps
+
+    def at(self, k: int) -> "LinearGaussianModel":
+        r"""Le modèle constant du pas ``k`` (:math:`A_k, B_k, C_k, Q_k, R_k`) ; le modèle lui-même s'il est
+        constant. Les matrices ne sont pas revérifiées (elles l'ont été à la construction)."""
+        if self._n_steps is None:
+            return self
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < self._n_steps:
+            raise KalmanInputError(
+                f"« k » doit être un indice de pas entier entre 0 et {self._n_steps - 1} ; reçu {k!r}."
+            )
+        return self.steps(self._n_steps)[k]
+
+    def steps(self, T: int) -> list["LinearGaussianModel"]:
+        """Les ``T`` modèles constants des pas d'un modèle variable (calculés une fois, puis gardés) ;
+        une :class:`KalmanInputError` si le modèle n'a pas ``T`` pas."""
+        if self._n_steps is None:
+            return [self] * T
+        if T != self._n_steps:
+            raise KalmanInputError(
+                f"Le modèle varie dans le temps sur {self._n_steps} pas (A, C, Q, R ou B de forme "
+                f"({self._n_steps}, …)) ; reçu {T} mesures. Donnez une ligne de matrices par mesure."
+            )
+        if self._steps is None:
+            pick = lambda a, k: None if a is None else (a[k] if a.ndim == 3 else a)  # noqa: E731
+            steps = [_constant_model(pick(self.A, k), pick(self.C, k), pick(self.Q, k), pick(self.R, k),
+                                     pick(self.B, k)) for k in range(T)]
+            object.__setattr__(self, "_steps", steps)
+        return self._steps
+
+    def sequence(self, name: str, T: int) -> np.ndarray:
+        """La matrice ``name`` (``"A"``, ``"B"``, ``"C"``, ``"Q"`` ou ``"R"``) de chacun des ``T`` pas,
+        (T, …) : la pile elle-même pour une matrice variable, la matrice constante répétée sinon (vue en
+        lecture seule)."""
+        if name not in ("A", "B", "C", "Q", "R"):
+            raise KalmanInputError(f"« name » doit valoir A, B, C, Q ou R ; reçu {name!r}.")
+        a = getattr(self, name)
+        if a is None:
+            raise KalmanInputError(f"Le modèle n'a pas de matrice « {name} ».")
+        if self._n_steps is not None:
+            self.steps(T)  # vérifie T
+        if a.ndim == 3:
+            return a
+        return np.broadcast_to(a, (T, *a.shape))
 
     @cached_property
     def noise_roots(self) -> tuple[np.ndarray, np.ndarray]:
@@ -127,7 +201,83 @@ class LinearGaussianModel:
         return _readonly(covariance_root(self.Q)), _readonly(covariance_root(self.R))
 
     def __repr__(self) -> str:
-        return f"LinearGaussianModel(n={self.n_state}, m={self.n_obs}, p={self.n_control})"
+        extra = "" if self._n_steps is None else f", variable sur {self._n_steps} pas"
+        return f"LinearGaussianModel(n={self.n_state}, m={self.n_obs}, p={self.n_control}{extra})"
+
+
+def _time_axis(matrices: dict[str, Any]) -> int | None:
+    """Longueur commune ``T`` des matrices données avec un axe des temps (3-D), ``None`` s'il n'y en a pas."""
+    lengths = {}
+    for name, value in matrices.items():
+        if value is not None and np.ndim(value) == 3:
+            lengths[name] = int(np.shape(value)[0])
+    if not lengths:
+        return None
+    if len(set(lengths.values())) > 1:
+        detail = ", ".join(f"{name} : {T}" for name, T in lengths.items())
+        raise KalmanInputError(
+            f"Les matrices variables dans le temps doivent avoir le même nombre de pas T ({detail})."
+        )
+    T = next(iter(lengths.values()))
+    if T == 0:
+        raise KalmanInputError("Un modèle variable dans le temps doit avoir au moins un pas (T ≥ 1).")
+    return T
+
+
+def _each_step(name: str, value: Any, T: int | None, check: Callable[[str, Any], np.ndarray],
+               covariance: str | None = None) -> np.ndarray:
+    """Vérifie une matrice constante, ou chaque ligne ``name[k]`` d'une pile (T, …) ; renvoie le tableau.
+
+    Pile de covariances (``covariance`` = ``"psd"`` ou ``"pd"``) : la forme est vérifiée sur la première
+    ligne, symétrie et positivité sur toutes à la fois (mêmes tolérances que
+    :func:`~kalman_course.core.validation.check_psd`, :func:`~kalman_course.core.validation.check_pd`) ;
+    la première ligne fautive est ensuite vérifiée seule, pour son message d'erreur."""
+    if value is None or np.ndim(value) != 3:
+        return check(name, value)
+    arr = as_float_array(name, value)
+    if covariance is None:
+        return np.array([check(f"{name}[{k}]", arr[k]) for k in range(T)])
+    check(f"{name}[0]", arr[0])  # forme (et première ligne)
+    scale = np.maximum(1.0, np.abs(arr).max(axis=(1, 2)))
+    asym = np.abs(arr - np.swapaxes(arr, 1, 2)).max(axis=(1, 2))
+    sym = 0.5 * (arr + np.swapaxes(arr, 1, 2))
+    ok = asym <= 1e-9 * scale
+    if ok.all():
+        if covariance == "psd":
+            ok = np.linalg.eigvalsh(sym)[:, 0] >= -1e-10 * scale
+        else:
+            try:
+                np.linalg.cholesky(sym)
+            except np.linalg.LinAlgError:
+                ok = np.array([_is_pd(M) for M in sym])
+    if not ok.all():
+        k = int(np.argmin(ok))
+        check(f"{name}[{k}]", arr[k])  # lève l'erreur française de cette ligne
+    return sym
+
+
+def _is_pd(M: np.ndarray) -> bool:
+    try:
+        np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        return False
+    return True
+
+
+def _constant_model(A, C, Q, R, B) -> LinearGaussianModel:
+    """Un modèle constant fait de matrices déjà vérifiées (les pas d'un modèle variable), sans recopie."""
+    model = object.__new__(LinearGaussianModel)
+    for name, value in (("A", A), ("C", C), ("Q", Q), ("R", R), ("B", B), ("_n_steps", None), ("_steps", None)):
+        object.__setattr__(model, name, value)
+    return model
+
+
+def model_steps(model: Any, T: int) -> list | None:
+    """Les modèles des ``T`` pas d'un modèle variable dans le temps (``model.steps(T)``), ``None`` pour un
+    modèle constant : le moteur des filtres appelle ``model.at(k)`` seulement quand il le faut."""
+    if not getattr(model, "time_varying", False):
+        return None
+    return model.steps(T)
 
 
 # --------------------------------------------------------------------------- modèle non linéaire
@@ -358,6 +508,11 @@ class NonlinearModel:
     def from_linear(cls, model: LinearGaussianModel) -> "NonlinearModel":
         r"""Le modèle linéaire :math:`f(x, u) = Ax + Bu`, :math:`h(x) = Cx`, vu comme un modèle non linéaire
         (jacobiennes constantes :math:`A` et :math:`C`). Sert à vérifier que l'EKF redonne alors le KF."""
+        if model.time_varying:
+            raise KalmanInputError(
+                "« model » varie dans le temps : NonlinearModel.from_linear n'accepte qu'un modèle constant "
+                "(prenez model.at(k) pour un pas)."
+            )
         A, B, C = model.A, model.B, model.C
 
         def f(x, u):  # x (n,) ou pile (N, n) : x Aᵀ (+ uᵀ Bᵀ) ligne par ligne

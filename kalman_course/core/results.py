@@ -88,6 +88,14 @@ class FilterResult:
         r"""Écarts-types a posteriori :math:`\sqrt{\operatorname{diag} P_{k\mid k}}`, forme (T, n)."""
         return np.sqrt(np.diagonal(self.P, axis1=-2, axis2=-1))
 
+    @property
+    def rejected(self) -> np.ndarray:
+        """(T,) booléen : pas dont la mesure, présente, a été **rejetée** par la porte du filtre
+        (``kalman_filter(..., gate=p)``) — prédiction seule, ``n_iter`` nul. Toujours ``False`` sans porte."""
+        if self.n_iter is None:
+            return np.zeros(self.observed.shape[:-1], dtype=bool)
+        return np.asarray(self.observed).any(axis=-1) & (np.asarray(self.n_iter) == 0)
+
     def __repr__(self) -> str:
         T = self.n_steps
         n, m = self.P.shape[-1], self.innovation.shape[-1]

@@ -70,6 +70,8 @@ def simulate(model: Any, x0: Any, n_steps: int, u: Any = None, *, rng: Any) -> S
     n, m = model.n_state, model.n_obs
     x = as_vector("x0", x0, n)
     U = as_controls("u", u, n_steps, model.n_control)
+    if isinstance(model, LinearGaussianModel) and model.time_varying:
+        return _simulate_time_varying(model, x, n_steps, U, gen)
     w = gen.standard_normal((n_steps, model.Q.shape[0])) @ covariance_factor(model.Q).T
     v = gen.standard_normal((n_steps, model.R.shape[0])) @ covariance_factor(model.R).T
     xs = np.empty((n_steps, n))
@@ -86,4 +88,22 @@ def simulate(model: Any, x0: Any, n_steps: int, u: Any = None, *, rng: Any) -> S
         x = model.transition(x, u_k) + model.process_noise_gain(x, u_k) @ w[k]
         xs[k] = x
         ys[k] = model.observe(x) + model.measurement_noise_gain(x) @ v[k]
+    return Simulation(x=xs, y=ys)
+
+
+def _simulate_time_varying(model: LinearGaussianModel, x: np.ndarray, n_steps: int, U, gen) -> Simulation:
+    r"""Simulation d'un modèle variable dans le temps : le pas ``k`` avec :math:`A_k, B_k, Q_k` puis la mesure
+    avec :math:`C_k, R_k` (``n_steps`` doit valoir ``model.n_steps``). Bruits tirés en bloc, comme
+    :func:`simulate`, puis mis à l'échelle pas par pas."""
+    steps = model.steps(n_steps)
+    z_w = gen.standard_normal((n_steps, model.n_state))
+    z_v = gen.standard_normal((n_steps, model.n_obs))
+    xs = np.empty((n_steps, model.n_state))
+    ys = np.empty((n_steps, model.n_obs))
+    for k, mk in enumerate(steps):
+        x = mk.A @ x + covariance_factor(mk.Q) @ z_w[k]
+        if U is not None:
+            x = x + mk.B @ U[k]
+        xs[k] = x
+        ys[k] = mk.C @ x + covariance_factor(mk.R) @ z_v[k]
     return Simulation(x=xs, y=ys)

@@ -23,6 +23,7 @@ from . import smoothing  # noqa: F401  (chapitre « Lissage : le lisseur RTS »)
 from . import likelihood  # noqa: F401  (chapitre « Apprendre Q et R : vraisemblance et données réelles »)
 from . import labs  # noqa: F401  (travaux pratiques : le filtre de l'étudiant contre celui du paquet)
 from . import tutorials  # noqa: F401  (travaux dirigés : les calculs à la main)
+from . import tracking  # noqa: F401  (chapitres « Plusieurs capteurs, temps irrégulier » et « Cibles qui manœuvrent »)
 from ._registry import REGISTRY, FigureSpec, draw, names, new_figure, register
 
 __all__ = ["REGISTRY", "FigureSpec", "draw", "names", "new_figure", "register"]

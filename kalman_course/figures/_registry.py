@@ -32,6 +32,8 @@ CHAPTER_TITLES: dict[str, str] = {
     "enkf": "Le filtre de Kalman d'ensemble (EnKF)",
     "lissage": "Lissage : le lisseur de Rauch–Tung–Striebel",
     "vraisemblance": "Apprendre Q et R : vraisemblance et données réelles",
+    "capteurs-temps-irregulier": "Plusieurs capteurs, temps irrégulier",
+    "cibles-manoeuvrantes": "Cibles qui manœuvrent : filtres adaptatifs et IMM",
     "srif": "Filtre d'information en racine carrée (SRIF)",
     "ekf-itere-se3": "EKF itéré sur SE(3) : pose d'une cible vue par une caméra",
     "tp-filtre-lineaire": "TP 1 — Le filtre de Kalman linéaire : la tension constante",

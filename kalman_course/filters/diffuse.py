@@ -191,7 +191,8 @@ def diffuse_information(model: LinearGaussianModel, augmented: FilterResult):
     r""":math:`J_k` (T, n, n) et :math:`h_k` (T, n) cumulés, à partir du filtre augmenté (voir le module)."""
     n = model.n_state
     obs = np.asarray(augmented.observed, dtype=bool)
-    E = np.where(obs[:, :, None], model.C[None] @ augmented.x_pred[:, :, 1:], 0.0)  # (T, m, n)
+    C = model.sequence("C", obs.shape[0])  # (T, m, n) : C_k (constante ou variable dans le temps)
+    E = np.where(obs[:, :, None], C @ augmented.x_pred[:, :, 1:], 0.0)  # (T, m, n)
     v, S = masked_innovations(augmented.innovation, augmented.S, obs)
     SiE = psd_solve(S, E)  # S⁻¹E par Cholesky (jamais d'inverse explicite)
     J = np.cumsum(np.swapaxes(E, 1, 2) @ SiE, axis=0)
@@ -252,11 +253,11 @@ def diffuse_kalman_filter(model: LinearGaussianModel, y: Any, u: Any = None) -> 
     rows = det_prev & obs.any(axis=1)
     if rows.any():
         o = obs[rows]
-        C_o = np.where(o[:, :, None], model.C[None], 0.0)  # lignes manquantes de C mises à 0
+        C_o = np.where(o[:, :, None], model.sequence("C", T)[rows], 0.0)  # lignes manquantes de C mises à 0
         # ν = y − C x̂⁻ = v − C(x̂⁻ − a⁻) : l'innovation du filtre conditionnel, corrigée de X⁻δ̂
         shift = x_pred[rows] - augmented.x_pred[rows][:, :, 0]
         nu = np.where(o, augmented.innovation[rows], 0.0) - (C_o @ shift[:, :, None])[:, :, 0]
-        S_rows = C_o @ P_pred[rows] @ np.swapaxes(C_o, 1, 2) + model.R
+        S_rows = C_o @ P_pred[rows] @ np.swapaxes(C_o, 1, 2) + model.sequence("R", T)[rows]
         _, S_solve = masked_innovations(nu, S_rows, o)
         K[rows] = np.swapaxes(psd_solve(S_solve, C_o @ P_pred[rows]), 1, 2)
         both = o[:, :, None] & o[:, None, :]

@@ -44,6 +44,7 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
+from ..core.models import model_steps
 from ..core.results import FilterHistory, FilterResult, FilterRuns
 from ..core.simulation import as_generator
 from ..core.validation import (
@@ -186,7 +187,9 @@ def run_filter(
 
     Paramètres
     ----------
-    model : le modèle de la famille (vérifié).
+    model : le modèle de la famille (vérifié). Un modèle variable dans le temps (``model.time_varying``,
+        par exemple un :class:`~kalman_course.LinearGaussianModel` à matrices (T, …)) : les étapes du pas
+        ``k`` reçoivent son modèle constant ``model.at(k)``.
     y : (T, m), ou (T,) si m = 1 — ``None`` ou ``NaN`` : mesure manquante (prédiction seule) ; une ligne
         partiellement manquante n'utilise que ses composantes observées.
     x0, P0 : a priori, vérifiés et convertis par ``family.prior``.
@@ -223,14 +226,16 @@ def run_filter(
     step_outputs = family.step_outputs
     xs, Ps, xps, Pps = out.x, out.P, out.x_pred, out.P_pred
     Ks, nus, Ss, n_iter = out.K, out.innovation, out.S, out.n_iter
+    steps = model_steps(model, T)  # modèle variable dans le temps : celui du pas k (model.at(k))
     for k in range(T):
-        predicted = predict(model, state, None if U is None else U[k])
+        mk = model if steps is None else steps[k]
+        predicted = predict(mk, state, None if U is None else U[k])
         if full[k]:
-            state, corr = update(model, predicted, Y[k], None)
+            state, corr = update(mk, predicted, Y[k], None)
             Ks[k], nus[k], Ss[k], n_iter[k] = corr
         elif some[k]:
             idx = np.flatnonzero(observed[k])
-            state, corr = update(model, predicted, Y[k, idx], idx)
+            state, corr = update(mk, predicted, Y[k, idx], idx)
             out.correction(k, corr, idx)
         else:
             state = predicted
@@ -298,13 +303,15 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
     Ss = np.full(lead + (T, m, m), np.nan)
     n_iter = np.zeros((N, T), dtype=int)
     run_by_run = U is not None and U.ndim == 3 and not family.batch_controls
+    steps = model_steps(model, T)  # modèle variable dans le temps : celui du pas k (model.at(k))
     for k in range(T):
+        mk = model if steps is None else steps[k]
         if run_by_run:
-            predicted = _predict_run_by_run(family, model, state, U[:, k], k)
+            predicted = _predict_run_by_run(family, mk, state, U[:, k], k)
         else:
-            predicted = family.predict_many(model, state, None if U is None else U[..., k, :], k)
+            predicted = family.predict_many(mk, state, None if U is None else U[..., k, :], k)
         if full[:, k].all():
-            state, corr = family.update_many(model, predicted, Yarr[:, k], None, k)
+            state, corr = family.update_many(mk, predicted, Yarr[:, k], None, k)
             if shared:
                 Ks[k], nus[:, k], Ss[k], n_iter[:, k] = corr
             else:
@@ -318,7 +325,7 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
                 runs = np.flatnonzero(group.ravel() == g)
                 idx = None if pattern.all() else np.flatnonzero(pattern)
                 y_g = Yarr[runs, k] if idx is None else Yarr[runs, k][:, idx]
-                new, corr = family.update_many(model, tuple(a[runs] for a in predicted), y_g, idx, k)
+                new, corr = family.update_many(mk, tuple(a[runs] for a in predicted), y_g, idx, k)
                 for a, b in zip(state, new):
                     a[runs] = b
                 _store_correction(Ks, nus, Ss, n_iter, runs, k, idx, corr)

@@ -42,6 +42,7 @@ from ..core.linalg import (
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult, FilterRuns
 from ..core.validation import KalmanInputError, as_gaussian, as_vector, check_control_allowed
+from .gating import fading_factor, gate_probability, gate_threshold, nis_value
 from .engine import (
     Correction, FilterFamily, gaussian_moments, gaussian_prior, gaussian_prior_many, run_filter, run_filter_runs,
 )
@@ -192,6 +193,8 @@ def kalman_filter(
     u: Any = None,
     *,
     form: str = FORMS[0],
+    gate: Any = None,
+    fading: Any = None,
 ) -> FilterResult:
     r"""Filtre de Kalman sur toutes les mesures : pour chaque ``y[k]``, prédiction puis correction.
 
@@ -211,14 +214,25 @@ def kalman_filter(
     form : ``"square_root"`` (par défaut : racine carrée de :math:`P`, sûre pour un :math:`P_0` vague),
         ``"textbook"`` (:math:`P = (I - KC)P^-`, la formule du cours) ou ``"joseph"`` — voir l'en-tête
         du module.
+    gate : probabilité :math:`0 < p < 1`, optionnelle — **porte** : une mesure dont le NIS
+        :math:`\nu_k^TS_k^{-1}\nu_k` dépasse le quantile :math:`\chi^2_{m_k}(p)` (:math:`m_k` composantes
+        observées) est rejetée et le pas se réduit à la prédiction (:mod:`~kalman_course.filters.gating`).
+        Un pas rejeté garde son innovation et sa covariance ``S`` (son NIS se lit par
+        :func:`~kalman_course.nis`), avec un gain nul ; ``result.rejected`` (T,) marque ces pas.
+    fading : facteur :math:`\alpha \ge 1`, optionnel — **mémoire évanescente** :
+        :math:`P_{k\mid k-1} = \alpha^2 A P_{k-1\mid k-1}A^T + Q` (``KalmanFilter.alpha`` de filterpy).
+
+    ``model`` peut varier dans le temps (matrices (T, …), voir
+    :class:`~kalman_course.LinearGaussianModel`) : le pas ``k`` prédit avec :math:`A_k, Q_k` et corrige
+    avec :math:`C_k, R_k`.
 
     Renvoie
     -------
     FilterResult
         ``x`` (T, n), ``P`` (T, n, n), ``x_pred``, ``P_pred``, ``K`` (T, n, m), ``innovation`` (T, m),
-        ``S`` (T, m, m), ``observed`` (T, m).
+        ``S`` (T, m, m), ``observed`` (T, m), ``rejected`` (T,).
     """
-    return run_filter(kalman_family(form), model, y, x0, P0, u)
+    return run_filter(kalman_family(form, gate=gate, fading=fading), model, y, x0, P0, u)
 
 
 def kalman_filter_runs(
@@ -287,7 +301,7 @@ def _observed_part(model: LinearGaussianModel, idx: np.ndarray | None, square_ro
     return model.C[idx], (covariance_root(R) if square_root else R)
 
 
-def kalman_family(form: str = FORMS[0]) -> FilterFamily:
+def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None) -> FilterFamily:
     r"""Les étapes du filtre de Kalman linéaire pour le moteur, un tirage
     (:func:`~kalman_course.filters.engine.run_filter`) ou ``N`` à la fois
     (:func:`~kalman_course.filters.engine.run_filter_runs`).
@@ -296,9 +310,15 @@ def kalman_family(form: str = FORMS[0]) -> FilterFamily:
     porte le calcul, :math:`P` est lue sur elle à chaque pas pour le résultat — et :math:`(\hat x, P)` pour
     les deux autres formes. Étapes en lot : la moyenne a une ligne par tirage (N, n), la covariance et sa
     racine sont communes à tous les tirages (n, n) (Riccati commune) ou une par tirage (N, n, n) ; la
-    commande est (p,) ou (N, p)."""
+    commande est (p,) ou (N, p).
+
+    ``gate`` et ``fading`` (voir :func:`kalman_filter`) ne servent qu'au filtre d'un tirage : leurs étapes
+    enveloppent ``predict`` (covariance multipliée par :math:`\alpha^2`, racine par :math:`\alpha`) et
+    ``update`` (NIS comparé au seuil avant la correction)."""
     form = _check_form(form)
     square_root, joseph = form == "square_root", form == "joseph"
+    p_gate = gate_probability(gate)
+    alpha2 = fading_factor(fading)
 
     def predict_mean(model, x, u):  # x̂⁻ = A x̂ + B u ; x (n,) ou une ligne par tirage (N, n)
         x_pred = x.dot(model.A.T)
@@ -376,6 +396,10 @@ def kalman_family(form: str = FORMS[0]) -> FilterFamily:
             X, P, K, S = correct_many(X_pred, P_pred, nu, C, R, joseph, where)
             return (X, P), Correction(K, nu, S)
 
+    if alpha2 is not None:
+        predict = _faded(predict, alpha2, square_root)
+    if p_gate is not None:
+        update = _gated(update, p_gate, square_root)
     return FilterFamily(
         name="filtre de Kalman",
         model_type=LinearGaussianModel,
@@ -390,3 +414,34 @@ def kalman_family(form: str = FORMS[0]) -> FilterFamily:
         batch_controls=True,
         shared_covariance=True,
     )
+
+
+def _faded(predict, alpha2: float, square_root: bool):
+    r"""Prédiction à mémoire évanescente : :math:`P_{k\mid k-1} = \alpha^2 A P A^T + Q` (la racine de
+    :math:`P` multipliée par :math:`\alpha`)."""
+    alpha = float(np.sqrt(alpha2))
+
+    def faded(model, state, u):
+        if square_root:
+            x, P, U = state
+            return predict(model, (x, alpha2 * P, alpha * U), u)
+        x, P = state
+        return predict(model, (x, alpha2 * P), u)
+
+    return faded
+
+
+def _gated(update, p_gate: float, square_root: bool):
+    r"""Correction derrière une porte : si le NIS :math:`\nu^TS^{-1}\nu` dépasse :math:`\chi^2_{m_k}(p)`, la
+    mesure est rejetée (état prédit inchangé, gain nul, ``n_iter`` = 0 : ``result.rejected``)."""
+
+    def gated(model, state, y, idx):
+        x_pred, P_pred = state[0], state[1]
+        C, R = _observed_part(model, idx, False)
+        nu = y - C.dot(x_pred)
+        S = symmetrize(C.dot(P_pred).dot(C.T) + R)
+        if nis_value(nu, S) > gate_threshold(p_gate, len(nu)):
+            return state, Correction(np.zeros((len(x_pred), len(nu))), nu, S, 0)
+        return update(model, state, y, idx)
+
+    return gated

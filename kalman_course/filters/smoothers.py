@@ -405,10 +405,17 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
         return _diffuse_rts(model, result)
     _check_dimensions(result, n, m)
     _check_finite(result)
-    A = model.A
+    A = A0 = model.A
+    Q, Q0, C, R = model.Q, model.Q, model.C, model.R
     x, P = result.x, result.P
-    x_next = (x[:-1] @ A.T) if model.B is None else None
-    _check_consistency(result, symmetrize(A @ P[:-1] @ A.T + model.Q), x_next, model.C, model.R,
+    if model.time_varying:  # les lignes k et k+1 sont reliées par les matrices du pas k+1
+        T = result.n_steps
+        A_all, Q_all = model.sequence("A", T), model.sequence("Q", T)
+        A, Q, A0, Q0 = A_all[1:], Q_all[1:], A_all[0], Q_all[0]
+        C, R = model.sequence("C", T), model.sequence("R", T)
+    At = np.swapaxes(A, -1, -2)
+    x_next = (x[:-1, None, :] @ At)[:, 0] if model.B is None else None
+    _check_consistency(result, symmetrize(A @ P[:-1] @ At + Q), x_next, C, R,
                        "filtre de Kalman", " (rts_smoother lisse la sortie de kalman_filter)")
     try:  # en racine carrée : sûr pour un a priori vague
         xs, Ps, G, lag = square_root_rts_pass(x, P, result.x_pred, A, model.noise_roots[0])
@@ -421,7 +428,7 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
     initial = (None, None, None)
     if prior is not None:
         x0_arr, P0_arr = prior
-        *initial, lag[0] = _smooth_initial(x0_arr, P0_arr, A, model.Q, A.dot(x0_arr) if model.B is None else None,
+        *initial, lag[0] = _smooth_initial(x0_arr, P0_arr, A0, Q0, A0.dot(x0_arr) if model.B is None else None,
                                            result, xs[0], Ps[0])
     return SmootherResult(xs, Ps, G, lag, *initial, method="RTS")
 
@@ -435,6 +442,11 @@ def _check_dimensions(result: FilterResult, n: int, m: int) -> None:
 
 
 def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> SmootherResult:
+    if model.time_varying:
+        raise KalmanInputError(
+            "rts_smoother : le lissage d'un départ diffus n'est écrit que pour un modèle constant ; pour un "
+            "modèle variable dans le temps, filtrez avec un a priori (kalman_filter(model, y, x0, P0))."
+        )
     aug = result.augmented
     n = model.n_state
     _check_dimensions(result, n, model.n_obs)

@@ -61,6 +61,7 @@ from . import ensemble  # noqa: F401  (« Le filtre de Kalman d'ensemble »)
 from . import likelihood  # noqa: F401  (« Apprendre Q et R »)
 from . import srif  # noqa: F401  (« Filtre d'information en racine carrée »)
 from . import se3  # noqa: F401  (« EKF itéré sur SE(3) »)
+from . import tracking  # noqa: F401  (« Plusieurs capteurs, temps irrégulier », « Cibles qui manœuvrent »)
 
 __all__ = [
     "ChoiceParameter",

@@ -17,6 +17,7 @@ from . import banana, distant_target  # noqa: F401  (UKF : la « banane » polai
 from . import growth, convergence, importance  # noqa: F401  (filtre particulaire, EnKF : bimodal, convergence, poids)
 from . import labs  # noqa: F401  (travaux pratiques : le filtre de l'étudiant contre celui du paquet)
 from . import tutorials  # noqa: F401  (travaux dirigés : les exemples calculés à la main)
+from . import helicopter, manoeuvre  # noqa: F401  (pistage : l'hélicoptère SAMU 31, la cible qui manœuvre)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
@@ -25,6 +26,8 @@ __all__ = [
     "convergence",
     "distant_target",
     "growth",
+    "helicopter",
+    "manoeuvre",
     "importance",
     "labs",
     "tutorials",

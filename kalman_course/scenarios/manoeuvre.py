@@ -1,0 +1,221 @@
+r"""Cibles qui manœuvrent : les expériences du chapitre « Cibles qui manœuvrent : filtres adaptatifs et
+IMM », écrites une fois.
+
+**En simulation** (la vérité est connue) : une cible à 50 m/s vole droit, vire à gauche (0,12 rad/s de 40 à
+60 s), revole droit, vire à droite (−0,08 rad/s de 90 à 115 s), suivie par un radar qui donne sa position
+toutes les secondes à 10 m près (virage coordonné exact, :func:`~kalman_course.core.motion.turn_transition`).
+Cinq filtres à vitesse presque constante la suivent :
+
+* ``calme`` — densité d'accélération :math:`q = 0{,}05` m²/s³, réglée pour la ligne droite ;
+* ``agité`` — :math:`q = 20` m²/s³, réglée pour les virages ;
+* ``oubli`` — le calme avec une mémoire évanescente :math:`\alpha = 1{,}2` ;
+* ``adaptatif`` — le calme avec :math:`Q` ajustée aux innovations (:func:`~kalman_course.filters.adaptive.adaptive_kalman_filter`) ;
+* ``IMM`` — les régimes calme et agité, probabilité de changer de régime 0,05 par pas.
+
+**Sur l'hélicoptère SAMU 31** (la vérité est inconnue) : l'IMM à deux régimes sur les deux capteurs de
+:mod:`~kalman_course.scenarios.helicopter`, et la probabilité du régime agité comparée à la vitesse de
+virage mesurée.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from ..core.models import LinearGaussianModel
+from ..core.motion import constant_velocity, turn_transition
+from ..core.results import FilterResult, freeze_fields
+from ..diagnostics.consistency import nees
+from ..filters.adaptive import adaptive_kalman_filter
+from ..filters.imm import IMMResult, imm_filter
+from ..filters.kalman import kalman_filter
+from .helicopter import helicopter_model, helicopter_track, prediction_rms
+
+__all__ = [
+    "SPEED", "DT", "N_STEPS", "TURNS", "POSITION_STD", "Q_QUIET", "Q_MANOEUVRE", "FADING", "SWITCH", "WINDOW",
+    "FILTERS", "turn_rate_profile", "simulate_target", "cv_model", "imm_transition", "run_filters",
+    "ManoeuvreStudy", "manoeuvre_study", "HelicopterIMM", "helicopter_imm", "measured_turn_rate",
+]
+
+#: Vitesse (m/s), pas (s), nombre de pas de la cible simulée.
+SPEED, DT, N_STEPS = 50.0, 1.0, 150
+#: Virages : (début, fin, vitesse de rotation en rad/s).
+TURNS = ((40.0, 60.0, 0.12), (90.0, 115.0, -0.08))
+#: Écart-type du radar (m).
+POSITION_STD = 10.0
+#: Densités d'accélération (m²/s³) des régimes calme et agité.
+Q_QUIET, Q_MANOEUVRE = 0.05, 20.0
+#: Facteur de mémoire évanescente, probabilité de changement de régime de l'IMM, fenêtre du filtre adaptatif.
+FADING, SWITCH, WINDOW = 1.2, 0.05, 5
+#: Les filtres comparés, dans l'ordre des figures.
+FILTERS = ("calme", "agité", "oubli", "adaptatif", "IMM")
+#: Nombre de trajectoires de la comparaison de Monte-Carlo et graine.
+N_RUNS, SEED = 50, 2021
+
+
+def turn_rate_profile(t: np.ndarray) -> np.ndarray:
+    """Vitesse de rotation vraie (rad/s) aux instants ``t`` (s)."""
+    w = np.zeros_like(np.asarray(t, dtype=float))
+    for start, end, rate in TURNS:
+        w[(t >= start) & (t < end)] = rate
+    return w
+
+
+def simulate_target(rng) -> tuple[np.ndarray, np.ndarray]:
+    r"""Une trajectoire vraie :math:`[e, n, v_e, v_n]` (T, 4) et ses relevés radar (T, 2), tirés avec ``rng``
+    (virage coordonné exact, pas de bruit d'état : la manœuvre est la seule surprise)."""
+    gen = np.random.default_rng(rng) if not isinstance(rng, np.random.Generator) else rng
+    t = DT * np.arange(1, N_STEPS + 1)
+    w = turn_rate_profile(t - DT)  # la rotation du pas qui mène à t
+    x = np.array([0.0, 0.0, SPEED, 0.0, 0.0])
+    truth = np.empty((N_STEPS, 4))
+    for k in range(N_STEPS):
+        x[4] = w[k]
+        x = turn_transition(x, DT)
+        truth[k] = x[:4]
+    y = truth[:, :2] + POSITION_STD * gen.standard_normal((N_STEPS, 2))
+    return truth, y
+
+
+def cv_model(q: float) -> LinearGaussianModel:
+    """Le modèle à vitesse presque constante de densité ``q`` (m²/s³), relevés de position à 10 m près."""
+    A, Q = constant_velocity(DT, q, dim=2)
+    return LinearGaussianModel(A, np.eye(4)[:2], Q, POSITION_STD**2 * np.eye(2))
+
+
+def imm_transition(switch: float) -> np.ndarray:
+    """Matrice de transition de l'IMM à deux régimes : quitter son régime avec la probabilité ``switch``."""
+    return np.array([[1.0 - switch, switch], [switch, 1.0 - switch]])
+
+
+X0 = np.array([0.0, 0.0, SPEED, 0.0])
+P0 = np.diag([POSITION_STD**2] * 2 + [25.0] * 2)
+
+
+def run_filters(y: np.ndarray, *, q_quiet: float = Q_QUIET, q_manoeuvre: float = Q_MANOEUVRE,
+                fading: float = FADING, switch: float = SWITCH) -> dict[str, FilterResult]:
+    """Les cinq filtres de :data:`FILTERS` sur les relevés ``y`` (T, 2)."""
+    quiet = cv_model(q_quiet)
+    return {
+        "calme": kalman_filter(quiet, y, X0, P0),
+        "agité": kalman_filter(cv_model(q_manoeuvre), y, X0, P0),
+        "oubli": kalman_filter(quiet, y, X0, P0, fading=fading),
+        "adaptatif": adaptive_kalman_filter(quiet, y, X0, P0, window=WINDOW),
+        "IMM": imm_filter([quiet, cv_model(q_manoeuvre)], y, X0, P0, transition=imm_transition(switch),
+                          mu0=[1.0 - switch, switch]),
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class ManoeuvreStudy:
+    r"""La comparaison de Monte-Carlo (:data:`N_RUNS` trajectoires, graine :data:`SEED`).
+
+    ``t`` (T,) s ; ``turning`` (T,) booléen : pas pendant un virage ; ``rmse`` (F, T) : erreur quadratique
+    moyenne de position de chaque filtre à chaque pas (m) ; ``nees`` (F, T) : NEES moyen (4 états) ;
+    ``rmse_straight``, ``rmse_turn`` (F,) : erreur quadratique moyenne de position en ligne droite et en
+    virage ; ``nees_mean`` (F,) : NEES moyen sur tout le vol ; ``band`` : intervalle à 95 % du NEES moyen
+    de :data:`N_RUNS` tirages d'un filtre cohérent ; ``example`` : les filtres de la première trajectoire ;
+    ``truth``, ``y`` : cette trajectoire ; ``names`` : :data:`FILTERS`."""
+
+    t: np.ndarray
+    turning: np.ndarray
+    rmse: np.ndarray
+    nees: np.ndarray
+    rmse_straight: np.ndarray
+    rmse_turn: np.ndarray
+    nees_mean: np.ndarray
+    band: tuple[float, float]
+    truth: np.ndarray
+    y: np.ndarray
+    example: dict
+    names: tuple[str, ...] = FILTERS
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "t", "rmse", "nees", "rmse_straight", "rmse_turn", "nees_mean", "truth", "y")
+
+    def index(self, name: str) -> int:
+        return self.names.index(name)
+
+
+@lru_cache(maxsize=1)
+def manoeuvre_study() -> ManoeuvreStudy:
+    """La comparaison des cinq filtres sur :data:`N_RUNS` trajectoires simulées (calculée une fois)."""
+    import scipy.stats
+
+    rng = np.random.default_rng(SEED)
+    t = DT * np.arange(1, N_STEPS + 1)
+    sq = np.zeros((len(FILTERS), N_STEPS))
+    ne = np.zeros((len(FILTERS), N_STEPS))
+    example = truth0 = y0 = None
+    for i in range(N_RUNS):
+        truth, y = simulate_target(rng)
+        results = run_filters(y)
+        if i == 0:
+            example, truth0, y0 = results, truth, y
+        for f, name in enumerate(FILTERS):
+            res = results[name]
+            sq[f] += np.sum((res.x[:, :2] - truth[:, :2]) ** 2, axis=1)
+            ne[f] += nees(truth, res)
+    rmse = np.sqrt(sq / N_RUNS)
+    nees_mean_t = ne / N_RUNS
+    # un virage et les 10 s qui le suivent (le temps de s'en remettre)
+    turning = np.zeros(N_STEPS, dtype=bool)
+    for start, end, _ in TURNS:
+        turning |= (t > start) & (t <= end + 10.0)
+    settled = t > 10.0
+    straight = settled & ~turning
+    rms = lambda mask: np.sqrt(np.mean(rmse[:, mask] ** 2, axis=1))  # noqa: E731
+    lo, hi = scipy.stats.chi2.ppf([0.025, 0.975], 4 * N_RUNS) / N_RUNS
+    return ManoeuvreStudy(t=t, turning=turning, rmse=rmse, nees=nees_mean_t, rmse_straight=rms(straight),
+                          rmse_turn=rms(turning), nees_mean=nees_mean_t[:, settled].mean(axis=1),
+                          band=(float(lo), float(hi)), truth=truth0, y=y0, example=example)
+
+
+# --------------------------------------------------------------------------- l'hélicoptère
+
+
+@dataclass(frozen=True, eq=False)
+class HelicopterIMM:
+    r"""L'IMM sur l'hélicoptère (deux capteurs) : ``result`` (:class:`~kalman_course.filters.imm.IMMResult`),
+    ``t`` (K,) s ; ``rate_t``, ``rate`` : vitesse de virage mesurée (°/s) aux messages de vitesse ;
+    ``mu_at_rate`` : probabilité du régime agité à ces instants ; ``correlation`` : leur corrélation
+    (avec :math:`|\text{vitesse de virage}|`) ; ``prediction_rms`` et ``prediction_rms_single`` (m) : erreur
+    de prédiction des positions de l'IMM et du filtre unique appris (:mod:`.helicopter`)."""
+
+    result: IMMResult
+    t: np.ndarray
+    rate_t: np.ndarray
+    rate: np.ndarray
+    mu_at_rate: np.ndarray
+    correlation: float
+    prediction_rms: float
+    prediction_rms_single: float
+
+
+def measured_turn_rate(flight) -> tuple[np.ndarray, np.ndarray]:
+    """Vitesse de virage (°/s) déduite des messages de vitesse successifs : instants (V,) et valeurs (V,)."""
+    heading = np.unwrap(np.arctan2(flight.velocity_east, flight.velocity_north))
+    return np.asarray(flight.velocity_t), np.rad2deg(np.gradient(heading, flight.velocity_t))
+
+
+@lru_cache(maxsize=None)
+def helicopter_imm(q_quiet: float = 0.1, q_manoeuvre: float = 30.0, switch: float = 0.05) -> HelicopterIMM:
+    """L'IMM calme/agité sur les deux capteurs du vol SAMU 31 (écarts-types de mesure appris)."""
+    from .helicopter import fitted_parameters, helicopter_filter
+
+    track = helicopter_track("both")
+    _, sp, sv = fitted_parameters("both")
+    modes = [helicopter_model(track, q, sp, sv) for q in (q_quiet, q_manoeuvre)]
+    res = imm_filter(modes, track.y, track.x0, track.P0, transition=imm_transition(switch),
+                     mu0=[1.0 - switch, switch])
+    rate_t, rate = measured_turn_rate(track.flight)
+    rows = np.searchsorted(np.asarray(track.t), np.round(rate_t, 3))
+    mu = res.mu[rows, 1]
+    return HelicopterIMM(
+        result=res, t=np.asarray(track.t), rate_t=rate_t, rate=rate, mu_at_rate=mu,
+        correlation=float(np.corrcoef(mu, np.abs(rate))[0, 1]),
+        prediction_rms=prediction_rms(res, track),
+        prediction_rms_single=prediction_rms(helicopter_filter("both"), track),
+    )

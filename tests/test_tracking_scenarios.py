@@ -1,0 +1,233 @@
+"""Le filtre à Q adaptative (contre une boucle écrite ici avec les étapes publiques predict/update) et les
+expériences des deux chapitres de pistage (hélicoptère SAMU 31, cible qui manœuvre) : les nombres que les
+chapitres citent, vérifiés contre des calculs indépendants ou des bornes qui peuvent échouer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.stats
+
+import kalman_course as kc
+from kalman_course.filters.gating import gate_threshold
+from kalman_course.scenarios import helicopter as heli
+from kalman_course.scenarios import manoeuvre as man
+
+
+# --------------------------------------------------------------------------- Q adaptative
+
+
+def adaptive_by_hand(model, y, x0, P0, window, min_scale, detect):
+    """La règle d'ajustement de covariance, écrite pas à pas avec kc.predict / kc.update ; le test du χ² par
+    scipy.stats."""
+    x, P, s = np.asarray(x0, float), np.asarray(P0, float), min_scale
+    ds, gs, nis, xs, scales = [], [], [], [], []
+    for k in range(len(y)):
+        scaled = kc.LinearGaussianModel(model.A, model.C, s * model.Q, model.R)
+        pred = kc.predict(scaled, x, P)
+        x, P = pred.x, pred.P
+        if not np.isnan(y[k]).any():
+            upd = kc.update(model, x, P, y[k])
+            g = np.trace(model.C @ model.Q @ model.C.T)
+            ds.append(upd.innovation @ upd.innovation - np.trace(upd.S) + s * g)
+            gs.append(g)
+            nis.append(upd.innovation @ np.linalg.solve(upd.S, upd.innovation))
+            quiet = detect is not None and sum(nis[-window:]) <= scipy.stats.chi2.ppf(detect, 2 * len(nis[-window:]))
+            s = min_scale if quiet else max(min_scale, sum(ds[-window:]) / sum(gs[-window:]))
+            x, P = upd.x, upd.P
+        xs.append(x)
+        scales.append(s)
+    return np.array(xs), np.array(scales)
+
+
+@pytest.mark.parametrize("window, min_scale, detect", [(1, 1.0, None), (5, 1.0, None), (8, 0.2, None),
+                                                       (5, 1.0, 0.99), (3, 0.5, 0.9)])
+def test_adaptive_filter_equals_the_rule_written_step_by_step(window, min_scale, detect):
+    truth, y = man.simulate_target(3)
+    y = np.array(y)
+    y[[20, 21, 70]] = np.nan
+    model = man.cv_model(man.Q_QUIET)
+    res = kc.adaptive_kalman_filter(model, y, man.X0, man.P0, window=window, min_scale=min_scale, detect=detect)
+    xs, scales = adaptive_by_hand(model, y, man.X0, man.P0, window, min_scale, detect)
+    assert np.allclose(res.x, xs, rtol=1e-10, atol=1e-8)
+    assert np.allclose(res.q_scale, scales, rtol=1e-10)
+
+
+def test_adaptive_filter_inflates_q_in_turns_only():
+    """Sans test, le rapport d'ajustement est si bruité (Q ≪ R) qu'il gonfle Q en ligne droite aussi ; avec
+    le test du χ² sur la fenêtre, Q ne grossit que dans les virages."""
+    t = man.DT * np.arange(1, man.N_STEPS + 1)
+    straight, turn = (t > 15) & (t < 38), (t > 45) & (t < 60)
+    for seed in range(5):
+        truth, y = man.simulate_target(seed)
+        raw = kc.adaptive_kalman_filter(man.cv_model(man.Q_QUIET), y, man.X0, man.P0, window=5, detect=None)
+        tested = kc.adaptive_kalman_filter(man.cv_model(man.Q_QUIET), y, man.X0, man.P0, window=5)
+        assert raw.q_scale[straight].max() > 100.0
+        assert np.all(tested.q_scale[straight] == 1.0)
+        assert tested.q_scale[turn].mean() > 100.0
+
+
+@pytest.mark.parametrize("kwargs, message", [(dict(window=0), "window"), (dict(min_scale=0.0), "min_scale")])
+def test_adaptive_options_are_checked(kwargs, message):
+    with pytest.raises(kc.KalmanInputError, match=message):
+        kc.adaptive_kalman_filter(man.cv_model(1.0), np.zeros((3, 2)), man.X0, man.P0, **kwargs)
+
+
+# --------------------------------------------------------------------------- hélicoptère
+
+
+def test_fitted_noise_is_a_likelihood_maximum():
+    """Le maximum trouvé par L-BFGS-B : aucune perturbation de ±2 % d'un paramètre ne fait mieux (vérifié
+    par des filtrages indépendants de l'optimiseur)."""
+    for sensors in heli.SENSORS:
+        fit = heli.helicopter_fit(sensors)
+        track = heli.helicopter_track(sensors)
+        best = fit.log_likelihood
+        p = np.array(fit.params)
+        for signs in np.vstack([np.eye(p.size), -np.eye(p.size)]):
+            moved = p * (1.0 + 0.02 * signs)
+            ll = kc.log_likelihood(heli.helicopter_model(track, *moved), track.y, track.x0, track.P0)
+            assert ll <= best + 1e-6, (sensors, moved, ll, best)
+
+
+def test_helicopter_track_merges_the_two_sensors_on_one_time_axis():
+    pos, both = heli.helicopter_track("position"), heli.helicopter_track("both")
+    f = kc.datasets.samu31()
+    assert pos.y.shape == (278, 2) and both.y.shape[1] == 4
+    assert both.position_rows.sum() == 278 and both.velocity_rows.sum() == f.velocity_t.size
+    assert np.all(np.diff(both.t) > 0) and np.all(both.dt > 0)
+    assert np.allclose(both.y[both.position_rows, :2], np.c_[f.east, f.north])
+    # l'a priori, 1 s avant la première position, la redonne par sa vitesse
+    assert np.allclose(both.x0[:2] + heli.PRIOR_LEAD * both.x0[2:], [f.east[0], f.north[0]])
+
+
+def test_velocity_reports_improve_the_position_prediction():
+    rms_pos = heli.prediction_rms(heli.helicopter_filter("position"), heli.helicopter_track("position"))
+    rms_both = heli.prediction_rms(heli.helicopter_filter("both"), heli.helicopter_track("both"))
+    assert rms_both < 0.85 * rms_pos, (rms_both, rms_pos)
+
+
+def test_prediction_rms_is_the_rms_of_the_position_innovations():
+    """Sur les positions seules, l'erreur de prédiction est exactement l'innovation du filtre."""
+    res = heli.helicopter_filter("position")
+    assert heli.prediction_rms(res, heli.helicopter_track("position")) == pytest.approx(
+        np.sqrt(np.mean(np.sum(res.innovation**2, axis=1))), rel=1e-12)
+
+
+def test_gate_study_numbers():
+    g = heli.gate_study()
+    # sans porte, la part des NIS au-delà du seuil χ²₂(0,99) est compatible avec 1 % (binomiale, 99,9 %)
+    lo, hi = scipy.stats.binom.interval(0.999, 278, 0.01)
+    assert lo <= g.exceed_99 * 278 <= hi
+    assert g.outliers_rejected == len(heli.OUTLIER_ROWS) and g.other_rejected <= 2
+    assert g.deviation_gated < 0.25 * g.deviation_plain
+    assert g.lost_at_99 is not None and g.lost_at_quiet is not None and g.lost_at_quiet < g.lost_at_99
+    assert g.rejected_999 <= 3
+
+
+def test_gated_run_with_outliers_equals_the_run_without_the_rejected_rows():
+    track = heli.helicopter_track("position")
+    gated = heli.helicopter_filter("position", gate=0.999, outliers=True)
+    y = heli.with_outliers(track)
+    y[gated.rejected] = np.nan
+    q, sp = heli.fitted_parameters("position")
+    plain = kc.kalman_filter(heli.helicopter_model(track, q, sp), y, track.x0, track.P0)
+    assert np.allclose(gated.x, plain.x, rtol=1e-12, atol=1e-9)
+
+
+# --------------------------------------------------------------------------- cible qui manœuvre
+
+
+def test_simulated_target_flies_the_announced_turns():
+    truth, y = man.simulate_target(0)
+    speed = np.hypot(truth[:, 2], truth[:, 3])
+    assert np.allclose(speed, man.SPEED, rtol=1e-12)
+    heading = np.unwrap(np.arctan2(truth[:, 3], truth[:, 2]))
+    total = sum(rate * (end - start) for start, end, rate in man.TURNS)
+    assert heading[-1] - heading[0] == pytest.approx(total, abs=1e-9)
+    assert np.std(y - truth[:, :2]) == pytest.approx(man.POSITION_STD, rel=0.1)
+
+
+def test_manoeuvre_study_ranks_the_filters():
+    st = man.manoeuvre_study()
+    i = st.index
+    assert st.rmse_turn[i("calme")] > 5 * st.rmse_turn[i("agité")]          # le filtre calme décroche
+    assert st.rmse_straight[i("IMM")] < st.rmse_straight[i("agité")]        # l'IMM lisse mieux en ligne droite
+    assert st.rmse_turn[i("IMM")] < 1.2 * st.rmse_turn[i("agité")]          # … et suit presque aussi bien en virage
+    assert st.rmse_turn[i("oubli")] < 0.5 * st.rmse_turn[i("calme")]
+    assert st.rmse_turn[i("adaptatif")] < 0.2 * st.rmse_turn[i("calme")]
+    assert st.nees_mean[i("calme")] > 10 * st.band[1]                        # incohérent : il se croit précis
+    lo, hi = scipy.stats.chi2.ppf([0.025, 0.975], 4 * man.N_RUNS) / man.N_RUNS
+    assert st.band == pytest.approx((lo, hi))
+
+
+def test_imm_probability_follows_the_helicopter_turns():
+    h = man.helicopter_imm()
+    assert h.correlation > 0.6
+    assert h.prediction_rms < h.prediction_rms_single * 1.05
+    assert np.allclose(h.result.mu.sum(axis=1), 1.0)
+
+
+# --------------------------------------------------------------------------- curseurs, contre filterpy
+
+
+def test_gate_slider_grid_equals_filterpy_with_a_hand_written_gate():
+    """Quelques points de la grille des curseurs de la porte : filterpy pas à pas (predict(F=A[k], Q=Q[k]),
+    NIS calculé ici, update sauté au-delà du quantile de scipy.stats)."""
+    from filterpy.kalman import KalmanFilter
+
+    import kalman_course.interactive as ki
+    from kalman_course.interactive import tracking
+
+    grid = ki.slider_grid("capteurs-porte-curseurs")
+    track = heli.helicopter_track("position")
+    y = heli.with_outliers(track)
+    sp = heli.fitted_parameters("position")[1]
+    for index in [(1, 4), (2, 4), (2, 1), (4, 4)]:
+        gate, q = grid.values_at(*index)
+        A, Q = kc.constant_velocity(track.dt, q, dim=2)
+        f = KalmanFilter(dim_x=4, dim_z=2)
+        f.H, f.R = np.eye(4)[:2], sp**2 * np.eye(2)
+        f.x, f.P = np.asarray(track.x0).reshape(4, 1), np.array(track.P0)
+        xs, rejected = [], 0
+        for k in range(len(y)):
+            f.predict(F=A[k], Q=Q[k])
+            nu = y[k].reshape(2, 1) - f.H @ f.x
+            S = f.H @ f.P @ f.H.T + f.R
+            if gate < 1.0 and (nu.T @ np.linalg.solve(S, nu)).item() > scipy.stats.chi2.ppf(gate, 2):
+                rejected += 1
+            else:
+                f.update(y[k].reshape(2, 1))
+            xs.append(f.x.ravel().copy())
+        run = grid.run(*index)
+        xs = np.array(xs)
+        assert int(run["n_rejected"][0]) == rejected, index
+        assert np.allclose(run["est_e"] * 1e3, xs[:, 0], rtol=1e-9, atol=1e-6), index
+        assert np.allclose(run["est_n"] * 1e3, xs[:, 1], rtol=1e-9, atol=1e-6), index
+    assert tracking.GATES[grid.default_index[0]] == 0.999
+
+
+def test_imm_slider_grid_equals_filterpy_immestimator():
+    from filterpy.kalman import IMMEstimator, KalmanFilter
+
+    import kalman_course.interactive as ki
+
+    grid = ki.slider_grid("manoeuvre-imm-curseurs")
+    st = man.manoeuvre_study()
+    for index in [grid.default_index, (0, 0, 3), (3, 2, 0)]:
+        switch, q1, q2 = grid.values_at(*index)
+        filters = []
+        for q in (q1, q2):
+            model = man.cv_model(q)
+            f = KalmanFilter(dim_x=4, dim_z=2)
+            f.F, f.H, f.Q, f.R = (np.array(a) for a in (model.A, model.C, model.Q, model.R))
+            f.x, f.P = man.X0.reshape(4, 1).copy(), man.P0.copy()
+            filters.append(f)
+        imm = IMMEstimator(filters, np.array([1 - switch, switch]),
+                           np.array([[1 - switch, switch], [switch, 1 - switch]]))
+        mus = []
+        for z in st.y:
+            imm.predict()
+            imm.update(z.reshape(2, 1))
+            mus.append(imm.mu[1])
+        assert np.allclose(grid.run(*index)["mu"], mus, rtol=1e-9, atol=1e-12), index
