@@ -65,12 +65,19 @@ def random_model(rng: np.random.Generator, n: int, m: int, p: int) -> kc.LinearG
 # a été rempli par le paquet actuel (même empreinte, scripts/package_hash.py), les tests en partent
 # d'une copie : aucun carnet n'est relancé pour rien.
 #
-# Une seule construction du site par session, lancée **en arrière-plan dès la fin de la collecte** : les
-# tests du paquet tournent pendant que les carnets s'exécutent (deux cœurs occupés). Les tests qui lisent
-# le livre (marqueurs book, browser, pdf) passent en dernier, dans cet ordre. Dès que le site est
-# construit, la construction LaTeX (même dossier, même environnement Sphinx et même cache d'exécution :
-# aucun carnet relancé, aucune page relue) et la compilation XeLaTeX partent à leur tour en arrière-plan,
-# pendant les tests du site et du navigateur ; les tests du PDF lisent leur résultat.
+# Une seule construction du site par session, lancée **en arrière-plan dès la fin de la collecte** (les
+# carnets absents du cache d'abord, en parallèle). Les tests qui lisent le livre (marqueurs book, browser,
+# pdf ; un test qui demande la fixture ``built_book`` ou ``pdf_build`` reçoit le marqueur qui lui manque)
+# passent en dernier, dans cet ordre : dans une session complète, les autres tests tournent pendant la
+# construction. Dès que le site est construit, la construction LaTeX (même dossier, même environnement
+# Sphinx et même cache d'exécution : aucun carnet relancé, aucune page relue) et la compilation XeLaTeX
+# partent à leur tour en arrière-plan, pendant les tests du site et du navigateur ; les tests du PDF lisent
+# leur résultat.
+#
+# ``bash scripts/test.sh`` sans argument lance deux sessions en même temps : celle du livre
+# (``-m "book or browser or pdf"``) et celle du paquet (le reste), qui ne construit rien. Les marqueurs
+# ajoutés ici le sont avant la sélection par ``-m`` : un test qui lit le livre ne tombe jamais dans la
+# session du paquet (où il déclencherait une seconde construction).
 
 sys.path.insert(0, str(ROOT / "scripts"))
 from package_hash import STAMP_NAME, package_hash  # noqa: E402
@@ -169,16 +176,27 @@ class _Book:
 BOOK = _Book()
 
 
+#: Fixture qui lit une construction → marqueur qu'elle impose au test qui la demande.
+BUILD_FIXTURES = {"built_book": "book", "pdf_build": "pdf"}
+
+
 def _stage(item) -> str | None:
     marks = {m.name for m in item.iter_markers()}
     for stage in reversed(STAGES):
         if stage in marks:
             return stage
-    return "book" if "built_book" in getattr(item, "fixturenames", ()) else None
+    return None
 
 
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(session, config, items):
-    """Les tests qui lisent le livre passent après tous les autres (site, navigateur, PDF)."""
+    """Marque les tests qui lisent une construction sans le dire (avant la sélection par ``-m``, qui suit
+    ce crochet) ; les tests qui lisent le livre passent après tous les autres (site, navigateur, PDF)."""
+    for item in items:
+        fixtures = getattr(item, "fixturenames", ())
+        wanted = [mark for fixture, mark in BUILD_FIXTURES.items() if fixture in fixtures]
+        if wanted and not _stage(item):
+            item.add_marker(wanted[-1])  # la dernière étape qu'il lit
     staged = [(STAGES.index(s), i, item) for i, item in enumerate(items) if (s := _stage(item))]
     if staged:
         rest = [item for item in items if not _stage(item)]
