@@ -123,6 +123,12 @@ from .se3_filter import (
     se3_nees,
     se3_predict,
 )
+# un seul filtre gaussien, des règles d'intégration (issue 22)
+from .filters.gaussian import GaussianRule, gaussian_filter, gaussian_filter_runs, gaussian_predict, gaussian_update
+from .filters.extended import Linearization
+from .filters.unscented import UnscentedRule
+from .filters.cubature import CubatureRule, cubature_kalman_filter, cubature_kalman_filter_runs
+from .filters.gauss_hermite import GaussHermiteRule, gauss_hermite_kalman_filter, gauss_hermite_kalman_filter_runs
 
 __all__ = [
     # modèles, résultat, erreurs
@@ -256,6 +262,20 @@ __all__ = [
     "expectation_maximization",
     "likelihood",
     "datasets",
+    # un seul filtre gaussien, des règles d'intégration
+    "GaussianRule",
+    "Linearization",
+    "UnscentedRule",
+    "CubatureRule",
+    "GaussHermiteRule",
+    "gaussian_filter",
+    "gaussian_filter_runs",
+    "gaussian_predict",
+    "gaussian_update",
+    "cubature_kalman_filter",
+    "cubature_kalman_filter_runs",
+    "gauss_hermite_kalman_filter",
+    "gauss_hermite_kalman_filter_runs",
     # sous-modules
     "errata",
     "figures",
