@@ -129,6 +129,8 @@ from .filters.extended import Linearization
 from .filters.unscented import UnscentedRule
 from .filters.cubature import CubatureRule, cubature_kalman_filter, cubature_kalman_filter_runs
 from .filters.gauss_hermite import GaussHermiteRule, gauss_hermite_kalman_filter, gauss_hermite_kalman_filter_runs
+# filtrer et lisser en parallèle dans le temps (issue 22)
+from .filters.parallel import parallel_kalman_filter, parallel_rts_smoother
 
 __all__ = [
     # modèles, résultat, erreurs
@@ -276,6 +278,8 @@ __all__ = [
     "cubature_kalman_filter_runs",
     "gauss_hermite_kalman_filter",
     "gauss_hermite_kalman_filter_runs",
+    "parallel_kalman_filter",
+    "parallel_rts_smoother",
     # sous-modules
     "errata",
     "figures",
