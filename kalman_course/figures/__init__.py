@@ -21,6 +21,9 @@ from . import srif  # noqa: F401  (chapitre « Filtre d'information en racine ca
 from . import se3  # noqa: F401  (chapitre « EKF itéré sur SE(3) : pose d'une cible vue par une caméra »)
 from . import smoothing  # noqa: F401  (chapitre « Lissage : le lisseur RTS »)
 from . import likelihood  # noqa: F401  (chapitre « Apprendre Q et R : vraisemblance et données réelles »)
+from . import gaussian  # noqa: F401  (chapitre « Un seul filtre gaussien »)
+from . import filter_choice  # noqa: F401  (chapitre « Quel filtre choisir ? »)
+from . import parallel  # noqa: F401  (chapitre « Filtrer en parallèle dans le temps »)
 from ._registry import REGISTRY, FigureSpec, draw, names, new_figure, register
 
 __all__ = ["REGISTRY", "FigureSpec", "draw", "names", "new_figure", "register"]

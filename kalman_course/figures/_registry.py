@@ -34,6 +34,9 @@ CHAPTER_TITLES: dict[str, str] = {
     "vraisemblance": "Apprendre Q et R : vraisemblance et données réelles",
     "srif": "Filtre d'information en racine carrée (SRIF)",
     "ekf-itere-se3": "EKF itéré sur SE(3) : pose d'une cible vue par une caméra",
+    "filtre-gaussien": "Un seul filtre gaussien : linéarisation, points sigma, cubature, Gauss–Hermite",
+    "quel-filtre": "Quel filtre choisir ?",
+    "filtrage-parallele": "Filtrer en parallèle dans le temps",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).
