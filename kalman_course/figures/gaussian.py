@@ -43,20 +43,22 @@ def gaussian_points():
         ("Gauss–Hermite p = 3 : 3² = 9 points", GaussHermiteRule(3), COLORS["Gauss–Hermite"]),
         ("Gauss–Hermite p = 5 : 5² = 25 points", GaussHermiteRule(5), COLORS["Gauss–Hermite, p = 5"]),
     )
-    fig, axes = new_figure(1, 4, width=11.0, height=3.3, sharex=True, sharey=True)
-    for ax, (title, rule, color) in zip(axes, panels):
+    fig, axes = new_figure(2, 2, width=7.5, height=7.2, sharex=True, sharey=True)
+    for ax, (title, rule, color) in zip(axes.ravel(), panels):
         pts = gaussian_rules.rule_points(rule, POINTS_MEAN, POINTS_COV)
         for k in (1.0, 2.0, 3.0):
             draw_ellipse(ax, POINTS_MEAN, POINTS_COV, k, color="0.6", lw=0.8, ls="--")
-        area = 600.0 * np.abs(pts.Wm) / np.abs(pts.Wm).max()
+        area = 900.0 * np.abs(pts.Wm) / np.abs(pts.Wm).max()
         ax.scatter(pts.points[:, 0], pts.points[:, 1], s=area, color=color, alpha=0.8, edgecolor="k", lw=0.5)
         ax.set_title(title, fontsize=9)
         ax.set_aspect("equal")
-        ax.set_xlabel("x₁ (sans unité)")
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("x₂ (sans unité)")
-    axes[0].set_xlim(-4.2, 4.2)
-    axes[0].set_ylim(-4.2, 4.2)
+    for ax in axes[1]:
+        ax.set_xlabel("x₁ (sans unité)")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("x₂ (sans unité)")
+    axes[0, 0].set_xlim(-4.2, 4.2)
+    axes[0, 0].set_ylim(-4.2, 4.2)
     return fig
 
 

@@ -24,7 +24,7 @@ def parallel_timings():
     ax0.loglog(m.T, m.parallel_smoother, "s--", color="tab:blue", alpha=0.6, label="parallel_rts_smoother")
     for T, s in zip(m.T[-1:], m.speedup[-1:]):
         ax0.annotate(f"× {format_number(s, decimals=1)}", (T, m.parallel[-1]), textcoords="offset points",
-                     xytext=(-40, -18), fontsize=9, color="tab:blue")
+                     xytext=(-10, 12), fontsize=9, color="tab:blue", ha="right")
     ax0.set_xlabel("longueur de la série T (pas)")
     ax0.set_ylabel("temps (s)")
     ax0.set_title(f"Temps mesurés (4 états, 2 mesures) — {m.date}", fontsize=10)

@@ -56,7 +56,7 @@ def rules_run(bearing_deg: float, order: float) -> dict[str, np.ndarray]:
 def _readout(series, values) -> str:
     p = int(round(values[1]))
     return (f"Distance de la moyenne à la vraie moyenne : linéarisation {number(1000 * series['lin_err'][0], 'mm')}, "
-            f"cubature {number(1000 * series['ckf_err'][0], 'mm')}, Gauss–Hermite ({p}^2 = {p * p} points) "
+            f"cubature {number(1000 * series['ckf_err'][0], 'mm')}, Gauss–Hermite ({p}² = {p * p} points) "
             f"{number(1000 * series['gh_err'][0], 'mm')}.")
 
 
@@ -69,7 +69,8 @@ def _glyphs(key: str, color: str, legend: str) -> tuple[Glyph, ...]:
 def rules_spec() -> SliderSpec:
     """La banane par la linéarisation, la cubature et Gauss–Hermite d'ordre p, contre la vérité."""
     sample = banana.banana_sample(300)
-    cloud = (Glyph("cloud_y", "scatter", "silver", "tirages (σθ = 20°)", x="cloud_x", marker="dot", size=3),)
+    cloud = (Glyph("cloud_y", "scatter", "gray", "tirages (σθ = 20°)", x="cloud_x", marker="circle", size=3,
+                   alpha=0.5),)
     return SliderSpec(
         name="gaussien-banane-regles",
         chapter=CHAPTER,
