@@ -26,7 +26,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.polynomial.hermite_e import hermegauss
 
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, FilterRuns
@@ -69,6 +68,8 @@ def gauss_hermite_points(n: int, order: int) -> tuple[np.ndarray, np.ndarray]:
             f"{MAX_POINTS} : baissez « order » ou prenez la règle de cubature (2n = {2 * int(n)} points) ou sans "
             "parfum (2n + 1 points)."
         )
+    from numpy.polynomial.hermite_e import hermegauss  # chargé au premier usage (import léger du paquet)
+
     nodes, w = hermegauss(p)
     w = w / np.sqrt(2.0 * np.pi)
     xi = np.array(list(itertools.product(nodes, repeat=int(n))), dtype=float)
