@@ -94,6 +94,7 @@ __all__ = [
     "correct_gaussian",
     "sigma_moments",
     "process_noises",
+    "where_text",
     "measurement_noises",
     "residuals",
 ]
@@ -122,7 +123,8 @@ class Moments(NamedTuple):
 class GaussianState(NamedTuple):
     r"""État interne du filtre gaussien pour le moteur : :math:`(\hat x, P)`, ``k`` l'indice de la mesure
     visée (pour nommer le pas dans un message) et, après une prédiction sans nouveaux points
-    (``redraw=False``), les points propagés :math:`f(\chi_i)` (N, n) que la correction réutilise."""
+    (``redraw=False``), les points propagés :math:`f(\chi_i)` (N, n) que la correction réutilise. Les étapes
+    de :func:`gaussian_family` en passent un tuple simple de même forme (moins coûteux à chaque pas)."""
 
     x: np.ndarray
     P: np.ndarray
@@ -131,6 +133,16 @@ class GaussianState(NamedTuple):
 
 
 # --------------------------------------------------------------------------- évaluations communes
+
+
+def where_text(where: Any) -> str:
+    """Le pas nommé dans un message : ``where`` est un texte, ou un couple ``(action, k)`` mis en forme
+    seulement quand une erreur est levée (« correction par y[12] ») — la boucle chaude ne formate rien."""
+    if isinstance(where, tuple):
+        action, k = where
+        return f"{action} y[{k}]"
+    return str(where)
+
 
 
 def process_noises(model: NonlinearModel, X: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
@@ -178,8 +190,11 @@ def weighted_mean(Z: np.ndarray, Wm: np.ndarray, angles: list[int] | tuple = ())
     r"""Moyenne pondérée des images ``Z`` (…, N, m) (points sur l'avant-dernier axe), **centrée sur le
     premier point** : :math:`Z_0 + \sum_i W^m_i (Z_i - Z_0)` (les :math:`W^m` somment à 1). Composantes
     angulaires ``angles`` : moyenne circulaire :math:`\operatorname{atan2}(\sum W^m\sin, \sum W^m\cos)`."""
-    Z0 = Z[..., :1, :]
-    z = Z0[..., 0, :] + Wm @ (Z - Z0)
+    if Z.ndim == 2:  # un seul état (la boucle chaude des filtres) : sans diffusion générale
+        z = Z[0] + Wm.dot(Z - Z[0])
+    else:
+        Z0 = Z[..., :1, :]
+        z = Z0[..., 0, :] + Wm @ (Z - Z0)
     if angles:
         angles = list(angles)
         z[..., angles] = np.arctan2(Wm @ np.sin(Z[..., angles]), Wm @ np.cos(Z[..., angles]))
@@ -199,6 +214,12 @@ def sigma_moments(X: np.ndarray, Z: np.ndarray, x: np.ndarray, Wm: np.ndarray, W
     (moyenne centrée sur le premier point, angles : moyenne circulaire et écarts ramenés dans
     :math:`(-\pi, \pi]`). Renvoie ``(mu (…, m), Sigma (…, m, m), C (…, n, m))``."""
     z = weighted_mean(Z, Wm, angles)
+    if Z.ndim == 2:
+        dZ = Z - z
+        if angles:
+            dZ[:, list(angles)] = wrap_angle(dZ[:, list(angles)])
+        WdZ = Wc[:, None] * dZ
+        return z, dZ.T.dot(WdZ), (X - x).T.dot(WdZ)
     dZ = Z - z[..., None, :]
     if angles:
         angles = list(angles)
@@ -241,7 +262,7 @@ class GaussianRule:
 
     def innovation_error(self, where: str) -> str:
         """Message quand :math:`S` n'est pas définie positive au pas ``where``."""
-        return f"{self.innovation_message()[:-1]} ({where})."
+        return f"{self.innovation_message()[:-1]} ({where_text(where)})."
 
     def transition(self, model, x, P, u, where: str) -> Moments:  # pragma: no cover - interface
         raise NotImplementedError
@@ -287,7 +308,7 @@ class SigmaPointRule(GaussianRule):
     def _factor_error(self, P: np.ndarray, where: str, what: str) -> KalmanInputError:
         lam_min = float(scipy.linalg.eigvalsh(P)[0])
         return KalmanInputError(
-            f"{self.label}, {where} : la covariance {what} n'est plus définie positive (plus petite valeur "
+            f"{self.label}, {where_text(where)} : la covariance {what} n'est plus définie positive (plus petite valeur "
             f"propre {number_text(lam_min, '.3g')}) : la factorisation de Cholesky des points {self.point_name} "
             f"échoue. {self.advice()}"
         )
@@ -309,7 +330,7 @@ class SigmaPointRule(GaussianRule):
             L = np.linalg.cholesky(P)
         except np.linalg.LinAlgError:
             for i in range(P.shape[0]):
-                self.points(X[i], P[i], f"tirage {i}, {where}", what)  # lève l'erreur du premier tirage fautif
+                self.points(X[i], P[i], f"tirage {i}, {where_text(where)}", what)  # lève l'erreur du premier tirage fautif
             raise self._factor_error(P[0], where, what) from None
         xi, _, _ = self.unit(X.shape[1])
         return X[:, None, :] + xi @ np.swapaxes(L, -1, -2)
@@ -373,20 +394,26 @@ class SymmetricSigmaRule(SigmaPointRule):
         return (xi, *self.weights(n))
 
     def points(self, x, P, where, what):
+        n = x.shape[0]
         try:
-            U = scipy.linalg.cholesky(self.scale(x.shape[0]) * P, lower=False, check_finite=False)
+            U = scipy.linalg.cholesky(self.scale(n) * P, lower=False, check_finite=False)
         except np.linalg.LinAlgError:
             raise self._factor_error(P, where, what) from None
-        plus = x + U
-        D = plus - x
-        return np.vstack([x[None]] * self.central + [plus, x - D])
+        c = int(self.central)
+        out = np.empty((2 * n + c, n))
+        if c:
+            out[0] = x
+        plus = out[c:c + n]
+        np.add(x, U, out=plus)
+        np.subtract(x, plus - x, out=out[c + n:])  # x − d exact : points exactement symétriques
+        return out
 
     def points_many(self, X, P, where, what):
         try:
             L = np.linalg.cholesky(self.scale(X.shape[1]) * P)
         except np.linalg.LinAlgError:
             for i in range(P.shape[0]):
-                self.points(X[i], P[i], f"tirage {i}, {where}", what)
+                self.points(X[i], P[i], f"tirage {i}, {where_text(where)}", what)
             raise self._factor_error(P[0], where, what) from None
         Xc = X[:, None, :]
         plus = Xc + np.swapaxes(L, -1, -2)
@@ -454,7 +481,7 @@ def correct_gaussian_many(rule, model, X_pred, P_pred, Y, idx, joseph, where, po
     C = mom.cross
     Ct = np.swapaxes(C, -1, -2)
     S = mom.cov + R
-    K = np.swapaxes(solve_pd_many(S, Ct, "S", rule.innovation_message(), where), -1, -2)
+    K = np.swapaxes(solve_pd_many(S, Ct, "S", rule.innovation_message(), where_text(where)), -1, -2)
     nu = residuals(model, Y, mom.mean, idx)
     X = X_pred + (K @ nu[..., None])[..., 0]
     KCt = K @ Ct
@@ -484,31 +511,30 @@ def gaussian_family(rule: GaussianRule, *, joseph: bool = False, redraw: bool = 
         x, P = as_gaussian(x0, P0, model.n_state, "x0", "P0")
         if rule.definite:
             P = check_pd("P0", P)  # les points demandent une racine de Cholesky de P0
-        return GaussianState(x, P, -1)
+        return (x, P, -1, None)
 
     def predict_step(model, state, u):
         x, P, k, _ = state
-        x_pred, P_pred, mom = predict_gaussian(rule, model, x, P, u, f"prédiction vers y[{k + 1}]")
-        return GaussianState(x_pred, P_pred, k + 1, mom.images if keep else None)
+        x_pred, P_pred, mom = predict_gaussian(rule, model, x, P, u, ("prédiction vers", k + 1))
+        return (x_pred, P_pred, k + 1, mom.images if keep else None)  # un GaussianState, en tuple simple
 
     def update_step(model, state, y, idx):
         x_pred, P_pred, k, points = state
-        x, P, K, nu, S = correct_gaussian(rule, model, x_pred, P_pred, y, idx, joseph, f"correction par y[{k}]",
-                                          points)
-        return GaussianState(x, P, k), Correction(K, nu, S)
+        x, P, K, nu, S = correct_gaussian(rule, model, x_pred, P_pred, y, idx, joseph, ("correction par", k), points)
+        return (x, P, k, None), Correction(K, nu, S)
 
     def prior_many(model, x0, P0, N):
         rule.check(model)
         return gaussian_prior_many(model, x0, P0, N, definite=rule.definite)
 
     def predict_many(model, state, u, k):
-        X_pred, P_pred, mom = predict_gaussian_many(rule, model, state[0], state[1], u, f"prédiction vers y[{k}]")
+        X_pred, P_pred, mom = predict_gaussian_many(rule, model, state[0], state[1], u, ("prédiction vers", k))
         return (X_pred, P_pred, mom.images) if keep else (X_pred, P_pred)
 
     def update_many(model, state, Y, idx, k):
         points = state[2] if keep else None
-        X, P, K, nu, S = correct_gaussian_many(rule, model, state[0], state[1], Y, idx, joseph, f"correction par y[{k}]",
-                                       points)
+        X, P, K, nu, S = correct_gaussian_many(rule, model, state[0], state[1], Y, idx, joseph, ("correction par", k),
+                                               points)
         return (X, P), Correction(K, nu, S)
 
     return FilterFamily(
