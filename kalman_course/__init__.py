@@ -129,6 +129,7 @@ from .filters.extended import Linearization
 from .filters.unscented import UnscentedRule
 from .filters.cubature import CubatureRule, cubature_kalman_filter, cubature_kalman_filter_runs
 from .filters.gauss_hermite import GaussHermiteRule, gauss_hermite_kalman_filter, gauss_hermite_kalman_filter_runs
+from .filters.posterior_linearization import iterated_posterior_linearization_filter
 # filtrer et lisser en parallèle dans le temps (issue 22)
 from .filters.parallel import parallel_kalman_filter, parallel_rts_smoother
 
@@ -278,6 +279,7 @@ __all__ = [
     "cubature_kalman_filter_runs",
     "gauss_hermite_kalman_filter",
     "gauss_hermite_kalman_filter_runs",
+    "iterated_posterior_linearization_filter",
     "parallel_kalman_filter",
     "parallel_rts_smoother",
     # sous-modules

@@ -73,6 +73,8 @@ FILTERS = [
     Member("GHKF (p=3)", lambda m, y, x0, P0, u=None: kc.gauss_hermite_kalman_filter(_nonlinear(m), y, x0, P0, u)),
     Member("GHKF en lot (p=2)", lambda m, y, x0, P0, u=None: kc.gauss_hermite_kalman_filter_runs(
         _nonlinear(m), np.asarray(y)[None], x0, P0, u, order=2).run(0)),
+    Member("IPLF (cubature)", lambda m, y, x0, P0, u=None: kc.iterated_posterior_linearization_filter(
+        _nonlinear(m), y, x0, P0, u)),
 ]
 IDS = [f.name for f in FILTERS]
 
