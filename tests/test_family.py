@@ -74,6 +74,17 @@ FILTERS = [
         _nonlinear(m), np.asarray(y)[None], x0, P0, u).run(0)),
     Member("UKF en lot", lambda m, y, x0, P0, u=None: unscented_kalman_filter_runs(
         _nonlinear(m), np.asarray(y)[None], x0, P0, u, alpha=1.0, beta=2.0, kappa=0.0).run(0)),
+    # le filtre gaussien et ses règles d'intégration (issue 22)
+    Member("filtre gaussien (linéarisation)", lambda m, y, x0, P0, u=None: kc.gaussian_filter(
+        _nonlinear(m), y, x0, P0, u, rule=kc.Linearization())),
+    Member("CKF", lambda m, y, x0, P0, u=None: kc.cubature_kalman_filter(_nonlinear(m), y, x0, P0, u)),
+    Member("CKF en lot", lambda m, y, x0, P0, u=None: kc.cubature_kalman_filter_runs(
+        _nonlinear(m), np.asarray(y)[None], x0, P0, u).run(0)),
+    Member("GHKF (p=3)", lambda m, y, x0, P0, u=None: kc.gauss_hermite_kalman_filter(_nonlinear(m), y, x0, P0, u)),
+    Member("GHKF en lot (p=2)", lambda m, y, x0, P0, u=None: kc.gauss_hermite_kalman_filter_runs(
+        _nonlinear(m), np.asarray(y)[None], x0, P0, u, order=2).run(0)),
+    Member("IPLF (cubature)", lambda m, y, x0, P0, u=None: kc.iterated_posterior_linearization_filter(
+        _nonlinear(m), y, x0, P0, u)),
 ]
 # pistage (issue 21) : options et filtres qui redeviennent le filtre de Kalman
 FILTERS += [

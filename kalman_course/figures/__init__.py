@@ -24,6 +24,9 @@ from . import likelihood  # noqa: F401  (chapitre « Apprendre Q et R : vraisemb
 from . import labs  # noqa: F401  (travaux pratiques : le filtre de l'étudiant contre celui du paquet)
 from . import tutorials  # noqa: F401  (travaux dirigés : les calculs à la main)
 from . import tracking  # noqa: F401  (chapitres « Plusieurs capteurs, temps irrégulier » et « Cibles qui manœuvrent »)
+from . import gaussian  # noqa: F401  (chapitre « Un seul filtre gaussien »)
+from . import filter_choice  # noqa: F401  (chapitre « Quel filtre choisir ? »)
+from . import parallel  # noqa: F401  (chapitre « Filtrer en parallèle dans le temps »)
 from ._registry import REGISTRY, FigureSpec, draw, names, new_figure, register
 
 __all__ = ["REGISTRY", "FigureSpec", "draw", "names", "new_figure", "register"]

@@ -43,6 +43,9 @@ CHAPTER_TITLES: dict[str, str] = {
     "td-filtre-lineaire": "TD 1 — Le gain de Kalman à la main",
     "td-filtres-a-points": "TD 2 — Filtres à points : calculs à la main",
     "td-lissage-em": "TD 3 — Lissage et EM à la main",
+    "filtre-gaussien": "Un seul filtre gaussien : linéarisation, points sigma, cubature, Gauss–Hermite",
+    "quel-filtre": "Quel filtre choisir ?",
+    "filtrage-parallele": "Filtrer en parallèle dans le temps",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

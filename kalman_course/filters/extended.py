@@ -6,12 +6,15 @@ bruits), :math:`\Phi \to Q`, :math:`\Psi \to R`, :math:`\hat x^-_{n+1} \to` ``x_
 * Prédiction : :math:`\hat x_{k\mid k-1} = f(\hat x_{k-1\mid k-1}, u_{k-1})`,
   :math:`P_{k\mid k-1} = F P_{k-1\mid k-1} F^T + W Q W^T`, :math:`F` et :math:`W` évaluées en
   :math:`(\hat x_{k-1\mid k-1}, u_{k-1})`.
-* Correction : celle du filtre linéaire (:func:`kalman_course.core.linalg.correct`, le même code) avec la
-  jacobienne :math:`H` évaluée en :math:`\hat x_{k\mid k-1}` à la place de :math:`C`, l'innovation
-  :math:`\nu_k = y_k - h(\hat x_{k\mid k-1})` (angles ramenés dans :math:`(-\pi,\pi]`) et
-  :math:`V R V^T` à la place de :math:`R`.
+* Correction : celle du filtre linéaire avec la jacobienne :math:`H` évaluée en :math:`\hat x_{k\mid k-1}` à
+  la place de :math:`C`, l'innovation :math:`\nu_k = y_k - h(\hat x_{k\mid k-1})` (angles ramenés dans
+  :math:`(-\pi,\pi]`) et :math:`V R V^T` à la place de :math:`R`.
 
-La correction itérée (Gauss–Newton) est dans :mod:`kalman_course.filters.iterated`.
+C'est le filtre gaussien (:mod:`kalman_course.filters.gaussian`) avec la règle de **linéarisation**
+(:class:`Linearization`) : :math:`\mathbb E[g(x)] \approx g(\hat x)`, :math:`\operatorname{Cov}[g(x)]
+\approx GPG^T`, :math:`\operatorname{Cov}[x, g(x)] \approx PG^T`, :math:`G = \partial g/\partial x\,(\hat x)` ;
+la correction gaussienne :math:`K = P_{xy}S^{-1}` avec :math:`P_{xy} = P^-H^T` est alors exactement celle du
+filtre linéaire. La correction itérée (Gauss–Newton) est dans :mod:`kalman_course.filters.iterated`.
 
 **Tirages en lot** (:func:`extended_kalman_filter_runs`) : les mêmes étapes sur une pile de ``N`` tirages
 (``X`` (N, n), ``P`` (N, n, n)). :math:`f` et :math:`h` passent par :meth:`NonlinearModel.transition_many`
@@ -25,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.linalg import correct, correct_many, symmetrize
+from ..core.linalg import S_NOT_PD
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, FilterRuns
 from ..core.validation import (
@@ -36,18 +39,24 @@ from ..core.validation import (
     check_control_allowed,
     check_instance,
 )
-from .engine import (
-    Correction,
-    FilterFamily,
-    gaussian_moments,
-    gaussian_prior,
-    gaussian_prior_many,
-    run_filter,
-    run_filter_runs,
+from .engine import FilterFamily, run_filter, run_filter_runs
+from .gaussian import (
+    NONLINEAR_HINT,
+    GaussianRule,
+    Moments,
+    correct_gaussian,
+    gaussian_family,
+    predict_gaussian_many,
+    measurement_noises,
+    predict_gaussian,
+    process_noises,
+    residuals,
 )
 from .kalman import Prediction, Update
 
 __all__ = [
+    "Linearization",
+    "LINEARIZATION",
     "ekf_predict",
     "ekf_update",
     "extended_kalman_filter",
@@ -56,10 +65,6 @@ __all__ = [
     "transition_jacobians",
     "observation_jacobians",
 ]
-
-#: Piste donnée quand un filtre non linéaire reçoit un modèle linéaire.
-NONLINEAR_HINT = "pour un modèle linéaire, utilisez kalman_filter ou NonlinearModel.from_linear"
-
 
 # --------------------------------------------------------------------------- vérifications
 
@@ -77,14 +82,72 @@ def check_control(model: NonlinearModel, u: Any) -> np.ndarray | None:
     return as_vector("u", u, model.n_control)
 
 
+# --------------------------------------------------------------------------- la règle de linéarisation
+
+
+class Linearization(GaussianRule):
+    r"""La règle de **linéarisation** du filtre gaussien (l'EKF) : :math:`g` remplacée par sa tangente en
+    :math:`\hat x`,
+
+    .. math::
+
+        \mathbb E[g(x)] \approx g(\hat x),\qquad \operatorname{Cov}[g(x)] \approx GPG^T,\qquad
+        \operatorname{Cov}[x, g(x)] \approx PG^T,\qquad G = \left.\frac{\partial g}{\partial x}\right|_{\hat x},
+
+    exacte pour :math:`g` affine. Une seule évaluation de :math:`g` et de sa jacobienne (analytique ou par
+    différences centrées) ; bruits non additifs acceptés (:math:`WQW^T`, :math:`VRV^T`)."""
+
+    label = "EKF"
+    filter_name = "filtre de Kalman étendu"
+
+    def innovation_message(self) -> str:
+        return S_NOT_PD
+
+    def __repr__(self) -> str:
+        return "Linearization()"
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Linearization)
+
+    def __hash__(self) -> int:
+        return hash(Linearization)
+
+    def transition(self, model, x, P, u, where):
+        F = model.transition_jacobian(x, u)
+        return Moments(model.transition(x, u), F.dot(P).dot(F.T), P.dot(F.T))
+
+    def observation(self, model, x, P, idx, where, points=None):
+        h = model.observe(x)
+        H = model.observation_jacobian(x)
+        if idx is not None:
+            h, H = h[idx], H[idx]
+        cross = P.dot(H.T)
+        return Moments(h, H.dot(cross), cross)
+
+    def transition_many(self, model, X, P, u, where):
+        F = transition_jacobians(model, X, u)
+        Ft = np.swapaxes(F, -1, -2)
+        return Moments(model.transition_many(X, u), F @ P @ Ft, P @ Ft)
+
+    def observation_many(self, model, X, P, idx, where, points=None):
+        h = model.observe_many(X)
+        H = observation_jacobians(model, X)
+        if idx is not None:
+            h, H = h[:, idx], H[..., idx, :]
+        cross = P @ np.swapaxes(H, -1, -2)
+        return Moments(h, H @ cross, cross)
+
+
+#: La règle de linéarisation (sans paramètre : une seule instance suffit).
+LINEARIZATION = Linearization()
+
+
 # --------------------------------------------------------------------------- noyaux internes
 
 
 def predict_moments(model: NonlinearModel, x: np.ndarray, P: np.ndarray, u: np.ndarray | None):
-    """Prédiction de l'EKF ; renvoie ``(x_pred, P_pred)``."""
-    F = model.transition_jacobian(x, u)
-    x_pred = model.transition(x, u)
-    P_pred = symmetrize(F.dot(P).dot(F.T) + model.process_noise(x, u))
+    """Prédiction de l'EKF (la prédiction gaussienne, règle de linéarisation) ; renvoie ``(x_pred, P_pred)``."""
+    x_pred, P_pred, _ = predict_gaussian(LINEARIZATION, model, x, P, u)
     return x_pred, P_pred
 
 
@@ -101,9 +164,7 @@ def linearize_observation(model: NonlinearModel, x: np.ndarray, y: np.ndarray, i
 
 
 def _ekf_correct(model, x_pred, P_pred, y, idx, joseph):
-    nu, H, R = linearize_observation(model, x_pred, y, idx)
-    x, P, K, S = correct(x_pred, P_pred, nu, H, R, joseph)
-    return x, P, K, nu, S
+    return correct_gaussian(LINEARIZATION, model, x_pred, P_pred, y, idx, joseph)
 
 
 # --------------------------------------------------------------------------- noyaux en lot
@@ -148,36 +209,13 @@ def observation_jacobians(model: NonlinearModel, X: np.ndarray) -> np.ndarray:
     return _stacked_jacobian(model, "h_jacobian", X, (), (model.n_obs, model.n_state), model.observation_jacobian)
 
 
-def process_noises(model: NonlinearModel, X: np.ndarray, u: np.ndarray | None = None) -> np.ndarray:
-    r""":math:`W_iQW_i^T` en chaque ligne de ``X`` (N, n) : (N, n, n), ou :math:`Q` (n, n) si le bruit est
-    additif ou :math:`W` constante."""
-    if model.f_noise_jacobian is None or not callable(model.f_noise_jacobian):
-        return model.process_noise(X[0], u)
-    return np.array([model.process_noise(x, u) for x in X])
 
-
-def measurement_noises(model: NonlinearModel, X: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:
-    r""":math:`V_iRV_i^T` en chaque ligne de ``X`` (N, n), restreinte aux composantes ``idx`` : (N, m, m),
-    ou :math:`R` (m, m) si le bruit est additif ou :math:`V` constante."""
-    if model.h_noise_jacobian is None or not callable(model.h_noise_jacobian):
-        R = model.measurement_noise(X[0])
-    else:
-        R = np.array([model.measurement_noise(x) for x in X])
-    return R if idx is None else R[..., idx[:, None], idx]
-
-
-def residuals(model: NonlinearModel, Y: np.ndarray, Y_hat: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:
-    r"""Résidus :math:`y_i - \hat y_i` d'une pile (N, m_k), composantes angulaires ramenées dans
-    :math:`(-\pi, \pi]` (``idx`` : composantes observées, comme :meth:`NonlinearModel.residual`)."""
-    return model.residual(Y, Y_hat, idx)
 
 
 def predict_moments_many(model: NonlinearModel, X: np.ndarray, P: np.ndarray, u: np.ndarray | None):
     r"""Prédiction de l'EKF sur ``N`` tirages : :math:`\hat X^- = f(\hat X)` (N, n),
     :math:`P^-_i = F_iP_iF_i^T + W_iQW_i^T` (N, n, n)."""
-    F = transition_jacobians(model, X, u)
-    X_pred = model.transition_many(X, u)
-    P_pred = symmetrize(F @ P @ np.swapaxes(F, -1, -2) + process_noises(model, X, u))
+    X_pred, P_pred, _ = predict_gaussian_many(LINEARIZATION, model, X, P, u, "prédiction")
     return X_pred, P_pred
 
 
@@ -189,13 +227,6 @@ def linearize_observations(model: NonlinearModel, X: np.ndarray, Y: np.ndarray, 
     if idx is not None:
         h, H = h[:, idx], H[..., idx, :]
     return residuals(model, Y, h, idx), H
-
-
-def _ekf_correct_many(model, X_pred, P_pred, Y, idx, joseph, k):
-    nu, H = linearize_observations(model, X_pred, Y, idx)
-    R = measurement_noises(model, X_pred, idx)
-    X, P, K, S = correct_many(X_pred, P_pred, nu, H, R, joseph, f"correction par y[{k}]")
-    return X, P, K, nu, S
 
 
 # --------------------------------------------------------------------------- étapes publiques
@@ -285,31 +316,6 @@ def extended_kalman_filter_runs(
 
 
 def extended_family(joseph: bool = False) -> FilterFamily:
-    r"""Les étapes de l'EKF pour le moteur (état interne :math:`(\hat x, P)`)."""
-
-    def predict_step(model, state, u):
-        return predict_moments(model, *state, u)
-
-    def update_step(model, state, y, idx):
-        x, P, K, nu, S = _ekf_correct(model, *state, y, idx, joseph)
-        return (x, P), Correction(K, nu, S)
-
-    def predict_many(model, state, u, k):
-        return predict_moments_many(model, *state, u)
-
-    def update_many(model, state, Y, idx, k):
-        X, P, K, nu, S = _ekf_correct_many(model, *state, Y, idx, joseph, k)
-        return (X, P), Correction(K, nu, S)
-
-    return FilterFamily(
-        name="filtre de Kalman étendu",
-        model_type=NonlinearModel,
-        model_hint=NONLINEAR_HINT,
-        prior=gaussian_prior,
-        predict=predict_step,
-        update=update_step,
-        moments=gaussian_moments,
-        prior_many=gaussian_prior_many,
-        predict_many=predict_many,
-        update_many=update_many,
-    )
+    r"""Les étapes de l'EKF pour le moteur : celles du filtre gaussien
+    (:func:`~kalman_course.filters.gaussian.gaussian_family`) avec la règle de linéarisation."""
+    return gaussian_family(LINEARIZATION, joseph=joseph)

@@ -236,8 +236,10 @@ def _combine(w: np.ndarray, X: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, n
 
 def imm_family() -> FilterFamily:
     r"""Les étapes de l'IMM pour le moteur (modèle : :class:`ModeSet`, état : :class:`IMMState`) ; chaque
-    régime passe par les étapes du filtre de Kalman (:func:`~kalman_course.filters.kalman.kalman_family`)."""
-    kf = kalman_family()
+    régime passe par les étapes du filtre de Kalman (:func:`~kalman_course.filters.kalman.kalman_family`), sous
+    la forme du cours (état :math:`(\hat x, P)` : le mélange des régimes forme des covariances, pas des
+    racines)."""
+    kf = kalman_family("textbook")
     kf_predict, kf_update = kf.predict, kf.update
 
     def prior(model: ModeSet, x0, P0) -> IMMState:

@@ -568,7 +568,8 @@ def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha
     (``alpha`` et ``kappa`` obligatoires, ``beta = 2`` par défaut) ; ``u`` (T, p) : les commandes données au
     filtre.
     """
-    from .unscented import _points, sigma_weights
+    from .gaussian import predict_gaussian
+    from .unscented import UnscentedRule
 
     _check_order(model, result, "unscented_rts_smoother")
     model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
@@ -577,19 +578,17 @@ def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha
     _check_dimensions(result, n, m)
     _check_finite(result)
     U = as_controls("u", u, T, model.n_control)
-    Wm, Wc, lam = sigma_weights(n, alpha=alpha, beta=beta, kappa=kappa)
+    rule = UnscentedRule(alpha, beta, kappa)
+    rule.check(model)
     x, P = result.x, result.P
     xb = np.empty((max(T - 1, 0), n))
     Pb = np.empty((max(T - 1, 0), n, n))
     G = np.zeros_like(P)
     for k in range(T - 1):
-        X = _points(x[k], P[k], n + lam, f"lissage du pas {k}", "filtrée P")
-        Xf = model.transition_many(X, None if U is None else U[k + 1])
-        xb[k] = Wm.dot(Xf)
-        D = Xf - xb[k]
-        Pb[k] = symmetrize(D.T.dot(Wc[:, None] * D) + model.Q)
-        C = (X - x[k]).T.dot(Wc[:, None] * D)
-        G[k] = np.linalg.solve(Pb[k], C.T).T  # G = C P̄⁻¹, P̄ symétrique
+        # la prédiction de l'UKF (filtre gaussien, même code) et sa covariance croisée C = Cov[x, f(x)]
+        xb[k], Pb[k], mom = predict_gaussian(rule, model, x[k], P[k], None if U is None else U[k + 1],
+                                             f"lissage du pas {k}")
+        G[k] = np.linalg.solve(Pb[k], mom.cross.T).T  # G = C P̄⁻¹, P̄ symétrique
     _check_consistency(result, Pb, xb, None, None, "filtre de Kalman sans parfum",
                        ", les mêmes paramètres (alpha, beta, kappa) et les mêmes commandes « u » "
                        "(unscented_rts_smoother lisse la sortie d'unscented_kalman_filter)")

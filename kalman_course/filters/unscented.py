@@ -41,17 +41,14 @@ est vectorisé (:meth:`~kalman_course.NonlinearModel.transition_many`), un appel
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Callable, NamedTuple
 
 import numpy as np
-import scipy.linalg
 
-from ..core.angles import wrap_angle
-from ..core.linalg import psd_solve, symmetrize
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult, FilterRuns
 from ..core.validation import (
-    number_text,
     KalmanInputError,
     as_float_array,
     as_gaussian,
@@ -59,10 +56,11 @@ from ..core.validation import (
     check_finite_output,
     check_pd,
 )
-from .engine import Correction, FilterFamily, gaussian_prior_many, run_filter, run_filter_runs
-from .extended import NONLINEAR_HINT, residuals
+from .engine import FilterFamily, run_filter, run_filter_runs
+from .gaussian import SymmetricSigmaRule, gaussian_family, sigma_moments
 
 __all__ = [
+    "UnscentedRule",
     "SigmaPoints",
     "UnscentedTransform",
     "sigma_weights",
@@ -72,11 +70,6 @@ __all__ = [
     "unscented_kalman_filter_runs",
     "unscented_family",
 ]
-
-#: Message d'une covariance d'innovation de l'UKF qui n'est pas définie positive.
-_S_NOT_PD = ("UKF, correction par y[{k}] : la covariance d'innovation S n'est pas définie positive (des poids W^c "
-             "négatifs peuvent la rendre indéfinie) : essayez un α plus grand ou κ ≥ 0.")
-
 
 class SigmaPoints(NamedTuple):
     r"""Points sigma et poids : ``points`` (2n+1, n) — ligne 0 : :math:`\chi_0 = \bar x`, lignes 1…n :
@@ -150,20 +143,6 @@ def _weights(n: int, alpha: float, beta: float, kappa: float) -> tuple[np.ndarra
     return Wm, Wc, lam
 
 
-def _points(x: np.ndarray, P: np.ndarray, scale: float, where: str, what: str) -> np.ndarray:
-    """Points sigma (2n+1, n) : lignes du facteur de Cholesky supérieur de ``scale · P``."""
-    try:
-        U = scipy.linalg.cholesky(scale * P, lower=False, check_finite=False)
-    except np.linalg.LinAlgError:
-        lam_min = float(scipy.linalg.eigvalsh(P)[0])
-        raise KalmanInputError(
-            f"UKF, {where} : la covariance {what} n'est plus définie positive (plus petite valeur propre "
-            f"{number_text(lam_min, '.3g')}) : la factorisation de Cholesky des points sigma échoue. Essayez un α plus grand "
-            "(poids W₀ moins négatifs), κ ≥ 0, ou augmentez Q ou P0."
-        ) from None
-    return np.vstack([x, x + U, x - U])
-
-
 def sigma_points(mean: Any, cov: Any, *, alpha: float, beta: float = 2.0, kappa: float = 0.0) -> SigmaPoints:
     r"""Les :math:`2n+1` points sigma de van der Merwe de la loi :math:`(\bar x, P)` et leurs poids.
 
@@ -180,8 +159,9 @@ def sigma_points(mean: Any, cov: Any, *, alpha: float, beta: float = 2.0, kappa:
     x, P = as_gaussian(x, cov, n, "mean", "cov")
     P = check_pd("cov", P)
     a, b, k = _check_parameters(n, alpha, beta, kappa)
-    Wm, Wc, lam = _weights(n, a, b, k)
-    return SigmaPoints(_points(x, P, n + lam, "points sigma", "« cov »"), Wm, Wc, lam)
+    rule = UnscentedRule(a, b, k)
+    Wm, Wc = rule.weights(n)
+    return SigmaPoints(rule.points(x, P, "points sigma", "« cov »"), Wm, Wc, rule.scale(n) - n)
 
 
 def unscented_transform(
@@ -228,177 +208,52 @@ def unscented_transform(
     for i in range(Y.shape[0]):
         check_finite_output("fn", Y[i], sp.points[i])
     angles = [int(i) for i in angle_indices]
-    y_mean = _weighted_mean(Y, sp.Wm, angles)
-    dY = _deviations(Y, y_mean, angles)
-    dX = sp.points - sp.points[0]
-    cov_y = dY.T.dot(sp.Wc[:, None] * dY)
-    cross = dX.T.dot(sp.Wc[:, None] * dY)
+    y_mean, cov_y, cross = sigma_moments(sp.points, Y, sp.points[0], sp.Wm, sp.Wc, angles)
     return UnscentedTransform(y_mean, cov_y, cross, sp.points, Y, sp.Wm, sp.Wc)
-
-
-# --------------------------------------------------------------------------- noyaux
-
-
-def _weighted_mean(Z: np.ndarray, Wm: np.ndarray, angles: list[int]) -> np.ndarray:
-    z = Wm.dot(Z)
-    if angles:
-        z[angles] = np.arctan2(Wm.dot(np.sin(Z[:, angles])), Wm.dot(np.cos(Z[:, angles])))
-    return z
-
-
-def _deviations(Z: np.ndarray, z: np.ndarray, angles: list[int]) -> np.ndarray:
-    d = Z - z
-    if angles:
-        d[:, angles] = wrap_angle(d[:, angles])
-    return d
-
-
-def _ukf_predict(model, x, P, u, Wm, Wc, scale, k):
-    X = _points(x, P, scale, f"prédiction vers y[{k}]", "a posteriori P")
-    Xf = model.transition_many(X, u)
-    x_pred = Wm.dot(Xf)
-    D = Xf - x_pred
-    P_pred = D.T.dot(Wc[:, None] * D) + model.Q
-    return x_pred, P_pred
-
-
-def _ukf_update(model, x_pred, P_pred, y, idx, Wm, Wc, scale, k):
-    X = _points(x_pred, P_pred, scale, f"correction par y[{k}]", "prédite P⁻")
-    Z = model.observe_many(X)
-    R = model.R
-    if idx is not None:
-        Z, R = Z[:, idx], R[np.ix_(idx, idx)]
-    angles = model.observed_angles(idx)
-    y_hat = _weighted_mean(Z, Wm, angles)
-    dZ = _deviations(Z, y_hat, angles)
-    WdZ = Wc[:, None] * dZ
-    S = dZ.T.dot(WdZ) + R
-    Pxy = (X - x_pred).T.dot(WdZ)
-    K = psd_solve(S, Pxy.T, message=_S_NOT_PD.format(k=k)).T
-    nu = model.residual(y, y_hat, idx)
-    x = x_pred + K.dot(nu)
-    P = symmetrize(P_pred - K.dot(S).dot(K.T))
-    return x, P, K, nu, S
-
-
-# --------------------------------------------------------------------------- noyaux en lot
-
-
-def _points_many(X: np.ndarray, P: np.ndarray, scale: float, where: str, what: str) -> np.ndarray:
-    """Points sigma de ``N`` tirages (N, 2n+1, n) : pour le tirage ``i``, ``X[i]`` puis ``X[i]`` ± les
-    lignes du facteur de Cholesky supérieur :math:`U_i` de ``scale · P[i]`` (:math:`U_i = L_i^T`)."""
-    try:
-        L = np.linalg.cholesky(scale * P)
-    except np.linalg.LinAlgError:
-        for i in range(P.shape[0]):
-            _points(X[i], P[i], scale, f"tirage {i}, {where}", what)  # lève l'erreur du premier tirage fautif
-        raise KalmanInputError(
-            f"UKF, {where} : une covariance {what} n'est plus définie positive : la factorisation de Cholesky "
-            "des points sigma échoue. Essayez un α plus grand, κ ≥ 0, ou augmentez Q ou P0."
-        ) from None
-    U = np.swapaxes(L, -1, -2)
-    Xc = X[:, None, :]
-    return np.concatenate([Xc, Xc + U, Xc - U], axis=1)
-
-
-def _ukf_predict_many(model, X, P, u, Wm, Wc, scale, k):
-    n = X.shape[1]
-    pts = _points_many(X, P, scale, f"prédiction vers y[{k}]", "a posteriori P")
-    Xf = model.transition_many(pts.reshape(-1, n), u).reshape(pts.shape)
-    X_pred = Wm @ Xf                                   # (N, n)
-    D = Xf - X_pred[:, None, :]
-    P_pred = np.swapaxes(D, -1, -2) @ (Wc[:, None] * D) + model.Q
-    return X_pred, P_pred
-
-
-def _ukf_update_many(model, X_pred, P_pred, Y, idx, Wm, Wc, scale, k):
-    N, n = X_pred.shape
-    pts = _points_many(X_pred, P_pred, scale, f"correction par y[{k}]", "prédite P⁻")
-    Z = model.observe_many(pts.reshape(-1, n)).reshape(N, pts.shape[1], model.n_obs)
-    R = model.R
-    if idx is not None:
-        Z, R = Z[..., idx], R[np.ix_(idx, idx)]
-    angles = model.observed_angles(idx)
-    y_hat = Wm @ Z                                     # (N, m_k)
-    if angles:
-        y_hat[:, angles] = np.arctan2(Wm @ np.sin(Z[..., angles]), Wm @ np.cos(Z[..., angles]))
-    dZ = Z - y_hat[:, None, :]
-    if angles:
-        dZ[..., angles] = wrap_angle(dZ[..., angles])
-    WdZ = Wc[:, None] * dZ
-    S = np.swapaxes(dZ, -1, -2) @ WdZ + R              # (N, m_k, m_k)
-    Pxy = np.swapaxes(pts - X_pred[:, None, :], -1, -2) @ WdZ  # (N, n, m_k)
-    K = np.swapaxes(psd_solve(S, np.swapaxes(Pxy, -1, -2), message=_S_NOT_PD.format(k=k)), -1, -2)
-    nu = residuals(model, Y, y_hat, idx)
-    X = X_pred + (K @ nu[..., None])[..., 0]
-    P = symmetrize(P_pred - K @ S @ np.swapaxes(K, -1, -2))
-    return X, P, K, nu, S
 
 
 # --------------------------------------------------------------------------- famille et boucle
 
 
-def _check_model(model: Any) -> NonlinearModel:
-    if isinstance(model, NonlinearModel) and (model.f_noise_jacobian is not None or model.h_noise_jacobian is not None):
-        raise KalmanInputError(
-            "L'UKF du paquet suppose des bruits additifs : le modèle ne doit avoir ni f_noise_jacobian ni "
-            "h_noise_jacobian (pour un bruit non additif, ajoutez le bruit à l'état : état augmenté)."
-        )
-    return model
+@dataclass(frozen=True)
+class UnscentedRule(SymmetricSigmaRule):
+    r"""La **transformée sans parfum** comme règle du filtre gaussien (l'UKF) : les :math:`2n + 1` points
+    sigma de van der Merwe, :math:`c = n + \lambda = \alpha^2(n + \kappa)`, et leurs poids (voir
+    l'en-tête du module). Exacte pour :math:`g` affine ; avec :math:`\alpha = 1, \beta = 0, \kappa = 0`,
+    :math:`W_0 = 0` et c'est la règle de cubature (:class:`~kalman_course.filters.cubature.CubatureRule`)."""
+
+    alpha: float
+    beta: float = 2.0
+    kappa: float = 0.0
+
+    label = "UKF"
+    filter_name = "filtre de Kalman sans parfum (UKF)"
+    point_name = "sigma"
+
+    def check(self, model: NonlinearModel) -> None:
+        super().check(model)
+        _check_parameters(model.n_state, self.alpha, self.beta, self.kappa)
+
+    def scale(self, n: int) -> float:
+        return n + (self.alpha**2 * (n + self.kappa) - n)  # n + λ, calculé comme filterpy
+
+    def weights(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        Wm, Wc, _ = _weights(n, self.alpha, self.beta, self.kappa)
+        return Wm, Wc
+
+    def advice(self) -> str:
+        return "Essayez un α plus grand (poids W₀ moins négatifs), κ ≥ 0, ou augmentez Q ou P0."
+
+    def innovation_message(self) -> str:
+        return ("UKF : la covariance d'innovation S n'est pas définie positive (des poids W^c négatifs peuvent la "
+                "rendre indéfinie) : essayez un α plus grand ou κ ≥ 0.")
 
 
 def unscented_family(alpha: float, beta: float = 2.0, kappa: float = 0.0) -> FilterFamily:
-    r"""Les étapes de l'UKF pour le moteur. État interne ``(x̂, P, k)`` : ``k`` est l'indice de la mesure
-    visée (il sert seulement à nommer le pas dans un message d'erreur)."""
-
-    def prior(model, x0, P0):
-        _check_model(model)
-        x, P = as_gaussian(x0, P0, model.n_state, "x0", "P0")
-        _check_parameters(model.n_state, alpha, beta, kappa)
-        return x, check_pd("P0", P), -1  # les points sigma demandent une racine de Cholesky de P0
-
-    def constants(model):
-        n = model.n_state
-        Wm, Wc, lam = _weights(n, *_check_parameters(n, alpha, beta, kappa))
-        return Wm, Wc, n + lam
-
-    def predict_step(model, state, u):
-        x, P, k = state
-        Wm, Wc, scale = constants(model)
-        return (*_ukf_predict(model, x, P, u, Wm, Wc, scale, k + 1), k + 1)
-
-    def update_step(model, state, y, idx):
-        x_pred, P_pred, k = state
-        Wm, Wc, scale = constants(model)
-        x, P, K, nu, S = _ukf_update(model, x_pred, P_pred, y, idx, Wm, Wc, scale, k)
-        return (x, P, k), Correction(K, nu, S)
-
-    def prior_many(model, x0, P0, N):
-        _check_model(model)
-        _check_parameters(model.n_state, alpha, beta, kappa)
-        return gaussian_prior_many(model, x0, P0, N, definite=True)  # racines de Cholesky des P0
-
-    def predict_many(model, state, u, k):
-        Wm, Wc, scale = constants(model)
-        return _ukf_predict_many(model, *state, u, Wm, Wc, scale, k)
-
-    def update_many(model, state, Y, idx, k):
-        Wm, Wc, scale = constants(model)
-        X, P, K, nu, S = _ukf_update_many(model, *state, Y, idx, Wm, Wc, scale, k)
-        return (X, P), Correction(K, nu, S)
-
-    return FilterFamily(
-        name="filtre de Kalman sans parfum (UKF)",
-        model_type=NonlinearModel,
-        model_hint=NONLINEAR_HINT,
-        prior=prior,
-        predict=predict_step,
-        update=update_step,
-        moments=lambda state: (state[0], state[1]),
-        prior_many=prior_many,
-        predict_many=predict_many,
-        update_many=update_many,
-    )
+    r"""Les étapes de l'UKF pour le moteur : celles du filtre gaussien
+    (:func:`~kalman_course.filters.gaussian.gaussian_family`) avec la règle :class:`UnscentedRule` (points
+    redessinés à la correction)."""
+    return gaussian_family(UnscentedRule(alpha, beta, kappa))
 
 
 def unscented_kalman_filter(

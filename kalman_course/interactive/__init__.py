@@ -62,6 +62,9 @@ from . import likelihood  # noqa: F401  (« Apprendre Q et R »)
 from . import srif  # noqa: F401  (« Filtre d'information en racine carrée »)
 from . import se3  # noqa: F401  (« EKF itéré sur SE(3) »)
 from . import tracking  # noqa: F401  (« Plusieurs capteurs, temps irrégulier », « Cibles qui manœuvrent »)
+from . import gaussian  # noqa: F401  (« Un seul filtre gaussien »)
+from . import filter_choice  # noqa: F401  (« Quel filtre choisir ? »)
+from . import parallel  # noqa: F401  (« Filtrer en parallèle dans le temps »)
 
 __all__ = [
     "ChoiceParameter",
