@@ -19,7 +19,7 @@ BOOK = ROOT / "book"
 
 
 #: Annexes du livre (ni objectifs, ni figure à curseurs, ni quiz).
-APPENDICES = {"references", "errata"}
+APPENDICES = {"references", "errata", "glossaire"}
 
 
 def _pages() -> list[str]:

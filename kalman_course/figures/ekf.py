@@ -6,6 +6,7 @@ import numpy as np
 
 from ..filters.extended import ekf_predict
 from ..core.models import NonlinearModel
+from ..scenarios.banana import banana_truth
 from ._geometry import draw_ellipse
 from ..numbers import format_spec as fr
 from ._registry import new_figure, register
@@ -40,7 +41,8 @@ def ekf_linearisation():
     rng = np.random.default_rng(LINEARISATION_SEED)
     samples = POLAR_MEAN + rng.standard_normal((3000, 2)) * POLAR_STD
     mapped = np.array([polar_to_cartesian(s) for s in samples])
-    mc_mean, mc_cov = mapped.mean(axis=0), np.cov(mapped.T)
+    exact = banana_truth(POLAR_STD[0], POLAR_STD[1], r=POLAR_MEAN[0], bearing=POLAR_MEAN[1])  # forme close
+    mc_mean, mc_cov = exact.mean, exact.cov
 
     fig, (ax0, ax1) = new_figure(1, 2, width=9.5, height=4.4, gridspec_kw={"width_ratios": [1, 1.3]})
     ax0.plot(samples[:, 0], np.rad2deg(samples[:, 1]), ".", ms=1.5, color="0.55", alpha=0.5)

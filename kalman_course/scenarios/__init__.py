@@ -14,6 +14,7 @@ from . import nile, smoothing  # noqa: F401  (le Nil et le niveau local ; la cib
 from . import pendulum  # noqa: F401  (pendule : UKF, filtre particulaire)
 from . import banana, distant_target  # noqa: F401  (UKF : la « banane » polaire, la cible lointaine)
 from . import growth, convergence, importance  # noqa: F401  (filtre particulaire, EnKF : bimodal, convergence, poids)
+from . import grid_bayes  # noqa: F401  (filtre bayésien exact sur une grille : le modèle de croissance)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
@@ -22,6 +23,7 @@ __all__ = [
     "convergence",
     "distant_target",
     "growth",
+    "grid_bayes",
     "importance",
     "diffuse",
     "nile",
