@@ -312,3 +312,21 @@ def test_solutions_are_titled_solution_and_chapter_references_are_quoted(built_b
     intro = (built_book / "book" / "intro.html").read_text()
     # les titres de chapitres cités sont entre guillemets français
     assert re.search(r"«\s*Le filtre de Kalman en images\s*»", htmllib.unescape(re.sub(r"<[^>]+>", "", intro)))
+
+
+def test_bibliography_style_writes_editions_and_collections_in_french():
+    """Le style des listes de références (kalman_course.book_citations) : « 4ᵉ édition », « Dans … éd. »,
+    jamais « 4 edition » ni « In »."""
+    from pybtex.database import parse_file
+
+    from kalman_course.book_citations import _formatting_style
+
+    style = _formatting_style()(label_style="alpha")
+    entries = parse_file(str(BOOK / "references.bib")).entries
+    text = {key: list(style.format_entries([entries[key]]))[0].text.render_as("text")
+            for key in ("shumway2017", "legland2011", "doucet2011")}
+    assert "4ᵉ édition" in text["shumway2017"] and "edition" not in text["shumway2017"]
+    for key in ("legland2011", "doucet2011"):
+        assert ". Dans Dan Crisan et Boris Rozovskii, éd., The Oxford Handbook" in text[key], text[key]
+        assert " In " not in text[key]
+    assert "une autre loi sinon" in text["legland2011"]  # la note est imprimée
