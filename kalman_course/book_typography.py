@@ -112,11 +112,12 @@ _MERMAID_LABEL = re.compile(r'"([^"\n]*)"')
 def typeset_mermaid(document) -> int:
     """Applique les règles aux étiquettes des diagrammes Mermaid (le code du diagramme est un attribut
     du nœud, que :func:`typeset` ne voit pas) ; seul le texte entre guillemets change, jamais la syntaxe
-    (« style A fill:#fff »). Renvoie le nombre de diagrammes modifiés."""
+    (« style A fill:#fff ») ; *a priori* et *a posteriori* y passent en italique (``<i>``). Renvoie le
+    nombre de diagrammes modifiés."""
     changed = 0
     for node in document.findall(lambda n: getattr(n, "tagname", "") == "mermaid" and "code" in n.attributes):
         old = node["code"]
-        new = _MERMAID_LABEL.sub(lambda m: '"' + _apply(m.group(1)) + '"', old)
+        new = _MERMAID_LABEL.sub(lambda m: '"' + _LATIN_HTML.sub(r"<i>\1</i>", _apply(m.group(1))) + '"', old)
         if new != old:
             node["code"] = new
             changed += 1
@@ -125,6 +126,8 @@ def typeset_mermaid(document) -> int:
 
 #: Locutions latines composées en italique dans le texte courant.
 _LATIN = re.compile(r"(?<![\w-])(a (?:priori|posteriori))(?![\w-])")
+#: La même, dans une étiquette HTML (Mermaid) : pas déjà entre ``<i>`` et ``</i>``.
+_LATIN_HTML = re.compile(r"(?<![\w-])(?<!<i>)(a (?:priori|posteriori))(?![\w-])")
 
 
 def italicize_latin(document) -> int:
@@ -214,6 +217,7 @@ def _transforms():
         default_priority = 900
 
         def run(self, **kwargs) -> None:
+            italicize_latin(self.document)  # textes résolus : titres cités par {ref}, nombres collés…
             typeset(self.document)
 
     return FrenchTypography, FrenchTypographyLate, QuotedDocumentTitles

@@ -53,7 +53,8 @@ def _slider_figures() -> int:
 
 
 def _title(doc: str) -> str:
-    return re.search(r"(?m)^# (.+)$", (ROOT / f"{doc}.md").read_text()).group(1).strip()
+    """Le titre du chapitre tel qu'imprimé (sans le balisage d'italique : « *unscented* » → « unscented »)."""
+    return re.sub(r"\*([^*]+)\*", r"\1", re.search(r"(?m)^# (.+)$", (ROOT / f"{doc}.md").read_text()).group(1).strip())
 
 
 def _flat(text: str) -> str:

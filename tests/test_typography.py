@@ -67,11 +67,12 @@ def test_mermaid_labels_get_the_same_typography_but_not_the_syntax():
     doc = publish_doctree("Texte.\n", settings_overrides={"report_level": 5})
     node = nodes.Element()
     node.tagname = "mermaid"
-    node["code"] = ('flowchart TB\n    K0["on fait confiance<br/>au <b>MODÈLE</b> : x̂ ≈ x̂⁻"]\n'
+    node["code"] = ('flowchart TB\n    K0["on fait confiance<br/>au <b>MODÈLE</b> : x̂ ≈ x̂⁻ a priori"]\n'
                     '    A["Matrice d\'état A"] -->|"n ← n+1 ; suite"| B\n    style K0 fill:#c8e6c9,stroke:#388e3c\n')
     doc += node
     assert typeset_mermaid(doc) == 1
     assert f"<b>MODÈLE</b>{NB}: x̂" in node["code"] and "Matrice d’état A" in node["code"]
+    assert "x̂⁻ <i>a priori</i>" in node["code"]
     assert f"n+1{NN}; suite" in node["code"]
     assert "style K0 fill:#c8e6c9,stroke:#388e3c" in node["code"]  # la syntaxe ne change pas
     assert typeset_mermaid(doc) == 0
