@@ -341,3 +341,119 @@ def test_no_line_of_prose_starts_with_a_high_punctuation_mark(page):
     la ligne de MyST en sépare deux."""
     bad = [line for line in _prose(_text(page)).splitlines() if re.match(r"^\s+[;:!?](\s|$)|^[;!?](\s|$)", line)]
     assert not bad, f"{page} : {bad[:3]}"
+
+
+# --------------------------------------------------------------------------- ordre des chapitres, références
+
+
+def _sections(text: str) -> list[str]:
+    return re.findall(r"^## (.+?)\s*$", text, re.M)
+
+
+def order_problems(text: str, first: str, then: str) -> list[str]:
+    """La section dont le titre contient ``first`` vient avant celle dont le titre contient ``then``."""
+    sections = [s.lower() for s in _sections(text)]
+    where = {key: next((i for i, s in enumerate(sections) if key.lower() in s), None) for key in (first, then)}
+    missing = [f"pas de section « {key} »" for key, i in where.items() if i is None]
+    if missing:
+        return missing
+    return [] if where[first] < where[then] else [f"« {first} » vient après « {then} »"]
+
+
+def test_order_check():
+    text = "# T\n\n## Intro\n\n## L'ensemble symétrique de Julier\n\n## Mettre à l'échelle : α\n"
+    assert order_problems(text, "ensemble symétrique", "mettre à l'échelle") == []
+    assert len(order_problems(text, "mettre à l'échelle", "ensemble symétrique")) == 1
+    assert len(order_problems(text, "grille", "mettre à l'échelle")) == 1
+
+
+def test_ukf_chapter_starts_from_julier_symmetric_set_then_scales():
+    """Issue 18 : l'ensemble symétrique de Julier (κ seul), la transformée, puis α et β et les poids négatifs ;
+    aucun α dans le texte avant la mise à l'échelle (sauf l'annonce du plan, en tête)."""
+    text = _text("ukf")
+    for first, then in (("ensemble symétrique de Julier", "transformée"), ("transformée", "mettre à l'échelle"),
+                        ("mettre à l'échelle", "le filtre")):
+        assert not order_problems(text, first, then), order_problems(text, first, then)
+    before_scaling = _prose(text.split("\n## Mettre à l'échelle", 1)[0].split("\n## ", 1)[1])
+    assert "\\alpha" not in before_scaling and "\\beta" not in before_scaling
+    # l'ensemble de Julier : poids κ/(n + κ) et 1/(2(n + κ)), vérifiés par une cellule (moment d'ordre 4)
+    julier = text.split("## L'ensemble symétrique de Julier", 1)[1].split("\n## ", 1)[0]
+    assert "W_0 = \\frac{\\kappa}{n + \\kappa}" in julier and "{glue:text}`m4_julier`" in julier
+
+
+def test_particle_chapter_opens_with_the_exact_grid_bayes_filter():
+    """Le filtre bayésien exact sur une grille (et ses deux modes) avant l'échantillonnage d'importance, calculé
+    par le scénario que les tests comparent au filtre de Kalman (tests/test_exact_references.py)."""
+    text = _text("filtre-particulaire")
+    assert not order_problems(text, "exact, sur une grille", "importance")
+    assert _sections(text).index("Le filtre bayésien exact, sur une grille") <= 1
+    grid = text.split("## Le filtre bayésien exact, sur une grille", 1)[1].split("\n## ", 1)[0]
+    assert "kc.scenarios.grid_bayes.growth_grid_posteriors()" in grid and "**deux modes**" in grid
+
+
+#: Les références françaises (ou de l'école française) que l'issue 18 demande, et le chapitre qui les cite.
+FRENCH_REFERENCES = {
+    "filtre-particulaire": ("leglandcours", "chopin2020", "cappe2005"),
+    "enkf": ("legland2011", "bocquet2014"),
+    "vraisemblance": ("cappe2005",),
+}
+
+
+@pytest.mark.parametrize("chapter, keys", sorted(FRENCH_REFERENCES.items()))
+def test_french_references_are_cited_where_they_are_the_reference(chapter, keys):
+    bib = (BOOK / "references.bib").read_text()
+    cited = set(re.findall(r"\{cite:[pt]\}`([^`]+)`", _text(chapter)))
+    cited = {key.split("-", 1)[-1] for group in cited for key in group.split(",")}
+    for key in keys:
+        assert re.search(rf"^@\w+\{{{key},", bib, re.M), f"{key} absent de references.bib"
+        assert key in cited, f"{chapter} ne cite pas {key}"
+
+
+def test_chapters_cite_the_second_edition_of_sarkka():
+    """Särkkä et Svensson (2023, 2ᵉ éd.) remplace l'édition de 2013 dans les chapitres (la page des références
+    garde la liste du support, qui cite l'édition de 2013)."""
+    for page in TOC:
+        if page != "references":
+            assert "sarkka2013" not in _text(page), page
+    assert any("sarkka2023" in _text(page) for page in CHAPTERS)
+
+
+# --------------------------------------------------------------------------- annexe des errata
+
+
+def verified_by_problems(entry: str) -> list[str]:
+    """Le champ « Vérifié par » d'une entrée de l'annexe : d'abord ce que la vérification calcule, en mots
+    (une phrase, pas un nom de test), puis, pour l'enseignant, le test qui la refait ; ou « rien à calculer »
+    (faute de français, notation) et pourquoi."""
+    if "Vérifié par\n:" not in entry:
+        return ["pas de champ « Vérifié par »"]
+    field = entry.split("Vérifié par\n:", 1)[1]
+    words, _, teacher = field.partition("*Pour l'enseignant* :")
+    plain = re.sub(r"\$[^$]*\$|\{\w+\}`[^`]*`", "x", words)
+    problems = []
+    if "`test_" in words:
+        problems.append("nom de test dans la phrase destinée à l'étudiant")
+    if len(re.findall(r"[a-zà-ÿ]{3,}", plain)) < 6:
+        problems.append("« Vérifié par » sans phrase en mots")
+    if words.strip().startswith("rien à calculer"):
+        return problems
+    if not re.search(r"`test_\w+`", teacher):
+        problems.append("pas de test nommé « Pour l'enseignant »")
+    return problems
+
+
+def test_verified_by_check():
+    good = ("Vérifié par\n: le filtre part de zéro et retrouve la tension vraie (chapitre {doc}`tension`).\n\n"
+            "  *Pour l'enseignant* : `test_voltage` (`tests/test_lecture_formulas.py`).\n")
+    assert verified_by_problems(good) == []
+    assert verified_by_problems("Vérifié par\n: rien à calculer : c'est une faute de français.\n") == []
+    assert len(verified_by_problems("Vérifié par\n: `test_voltage` (`tests/test_errata.py`).\n")) == 3
+    assert len(verified_by_problems(good.split("  *Pour")[0])) == 1
+    assert verified_by_problems("Écrit\n: x\n") == ["pas de champ « Vérifié par »"]
+
+
+def test_errata_entries_say_what_checks_them_in_words_then_name_the_test():
+    entries = re.split(r"^\(errata-[\w-]+\)=$", _text("errata"), flags=re.M)[1:]
+    assert len(entries) >= 70
+    problems = [f"{entry.split(chr(10), 2)[1][:40]} : {p}" for entry in entries for p in verified_by_problems(entry)]
+    assert not problems, "\n".join(problems)
