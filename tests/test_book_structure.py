@@ -197,15 +197,27 @@ def test_wording_of_the_course(page):
     assert not problems, f"{page} : " + " ; ".join(problems)
 
 
-_SOFTWARE = re.compile(r"\b[Ll]es tests (?:du paquet )?(?:vérifient|comparent)")
+_SOFTWARE = re.compile(r"\b[Ll]es tests (?:du paquet )?(?:vérifient|comparent)|`test_\w+`")
+
+
+def software_talk_outside_boxes(text: str) -> list[str]:
+    """« Les tests vérifient… » ou un nom de test dans la prose, hors des encadrés « Dans le paquet »."""
+    outside = re.sub(r":::\{admonition\} Dans le paquet\n.*?\n:::", "", text, flags=re.S)
+    return [m.group(0) for m in _SOFTWARE.finditer(_prose(outside))]
+
+
+def test_software_talk_check():
+    assert software_talk_outside_boxes("La covariance est juste (test `test_joseph`). Les tests vérifient tout.") \
+        == ["`test_joseph`", "Les tests vérifient"]
+    boxed = ":::{admonition} Dans le paquet\n:class: seealso\nLe test `test_joseph` la compare.\n:::\n"
+    assert software_talk_outside_boxes("La covariance est juste.\n\n" + boxed) == []
 
 
 @pytest.mark.parametrize("chapter", CHAPTERS)
 def test_software_talk_stays_in_the_package_boxes(chapter):
     """« Les tests vérifient… » : hors des dérivations, dans un encadré « Dans le paquet » (ou en note)."""
-    text = _text(chapter)
-    outside = re.sub(r":::\{admonition\} Dans le paquet\n.*?\n:::", "", text, flags=re.S)
-    assert not _SOFTWARE.search(_prose(outside)), f"{chapter} : « {_SOFTWARE.search(_prose(outside)).group(0)} »"
+    found = software_talk_outside_boxes(_text(chapter))
+    assert not found, f"{chapter} : {found}"
 
 
 # --------------------------------------------------------------------------- notations
