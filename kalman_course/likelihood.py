@@ -606,7 +606,7 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
     .. math::
 
         Q' = \frac1{N_Q}\sum_k \Big[r_kr_k^T + P_{k\mid T} - P_{k,k-1\mid T}A^T - AP_{k,k-1\mid T}^T
-        + AP_{k-1\mid T}A^T\Big],\quad r_k = \hat x_{k\mid T} - A\hat x_{k-1\mid T} - Bu_k,
+        + AP_{k-1\mid T}A^T\Big],\quad r_k = \hat x_{k\mid T} - A\hat x_{k-1\mid T} - Bu_{k-1},
 
         R' = \frac1T\sum_k \Big[e_ke_k^T + CP_{k\mid T}C^T\Big],\quad e_k = y_k - C\hat x_{k\mid T},
 

@@ -334,9 +334,10 @@ def french_figure(figure) -> None:
             text.set_text(new)
 
 
-def bokeh_tick_formatter():
+def bokeh_tick_formatter(group_thousands: bool = True):
     """Un formateur de graduations Bokeh (``CustomJSTickFormatter``) : virgule décimale, signe moins
-    typographique, puissances de dix :math:`\\times 10^{n}` (même rendu que :func:`format_number`)."""
+    typographique, puissances de dix :math:`\\times 10^{n}` (même rendu que :func:`format_number`).
+    ``group_thousands=False`` pour un axe d'années : « 1880 », jamais « 1 880 »."""
     from bokeh.models import CustomJSTickFormatter
 
     code = r"""
@@ -346,7 +347,7 @@ def bokeh_tick_formatter():
     const french = (s) => {
         const neg = s.startsWith("-");
         const [int, dec] = (neg ? s.slice(1) : s).split(".");
-        const grouped = int.replace(/\B(?=(\d{3})+(?!\d))/g, "\u202f");
+        const grouped = group ? int.replace(/\B(?=(\d{3})+(?!\d))/g, "\u202f") : int;
         return (neg ? "\u2212" : "") + grouped + (dec ? "," + dec : "");
     };
     const a = Math.abs(tick);
@@ -358,7 +359,7 @@ def bokeh_tick_formatter():
     }
     return french(String(Number(tick.toPrecision(6))));
     """
-    return CustomJSTickFormatter(code=code)
+    return CustomJSTickFormatter(args={"group": bool(group_thousands)}, code=code)
 
 
 def glue_number(name: str, value: Any, spec: str | None = None, **options: Any) -> str:

@@ -28,7 +28,7 @@ LINEAR_CHAPTERS = [
     "pratique-synthese",
 ]
 # Annexes : pages sans figure ni exercice.
-APPENDICES = {"references", "errata"}
+APPENDICES = {"references", "errata", "glossaire"}
 # Travaux pratiques : l'étudiant écrit les fonctions ; la solution (repliée) est son code, vérifié par
 # practice.check à la construction.
 PRACTICAL_WORK = {Path(f).stem for f in (ROOT / "book").glob("tp-*.md")}
@@ -281,15 +281,61 @@ def test_errata_appendix_has_the_corrections_the_chapters_did_not_cover():
             assert field in entry, entry[:80]
 
 
+#: Longueur maximale d'une note d'erratum, une fois les rôles remplacés par leur texte (une ligne ou deux).
+ERRATUM_NOTE_MAX = 200
+
+
+def erratum_note_problems(text: str, labels: set[str]) -> list[str]:
+    """Ce qui ne va pas dans les corrections du support d'une page MyST : une correction est une note de bas
+    de page d'une ligne, « [^id]: Erratum {ref}`001-7 <errata-001-7>` : … », appelée dans le texte et qui
+    renvoie à des entrées existantes de l'annexe ; aucun encadré « Erratum » ne coupe le texte."""
+    problems = []
+    if re.search(r"^:{3,}\{admonition\} Errat", text, re.M):
+        problems.append("encadré « Erratum » dans le texte (une note de bas de page d'une ligne suffit)")
+    for fid, note, after in re.findall(r"^\[\^([\w-]+)\]: (Errat(?:um|a)\b.*)\n(.*)", text + "\n", re.M):
+        links = re.findall(r"\{ref\}`[^`<]+<(errata-[\w-]+)>`", note)
+        if not links:
+            problems.append(f"note {fid} sans lien vers l'annexe")
+        if set(links) - labels:
+            problems.append(f"note {fid} : entrée(s) inconnue(s) {sorted(set(links) - labels)}")
+        if after.strip():
+            problems.append(f"note {fid} sur plusieurs lignes")
+        plain = re.sub(r"\{ref\}`([^`<]*?) ?<[^>]*>`", r"\1", note)
+        plain = re.sub(r"\{(?:glue:text|eq)\}`[^`]*`", "0,000", plain)
+        if len(plain) > ERRATUM_NOTE_MAX:
+            problems.append(f"note {fid} trop longue ({len(plain)} caractères)")
+        if text.count(f"[^{fid}]") < 2:
+            problems.append(f"note {fid} jamais appelée dans le texte")
+    # une correction hors note (un renvoi « Détails : » à l'annexe, reste d'un ancien encadré)
+    if re.search(r"^Détails : \{ref\}`errata", text, re.M):
+        problems.append("renvoi « Détails : » à l'annexe hors d'une note")
+    return problems
+
+
+def test_erratum_note_check_flags_boxes_long_notes_and_dead_links():
+    labels = {"errata-001-7", "errata-001-8"}
+    good = ("La recette, étape 3.[^e1]\n\n[^e1]: Erratum {ref}`001-7 <errata-001-7>` : le support écrit "
+            "$\\Psi$ au lieu de $\\Phi$.\n\nSuite du texte.\n")
+    assert erratum_note_problems(good, labels) == []
+    box = ":::{admonition} Erratum 001-7\n:class: warning\nLong encadré.\nDétails : {ref}`errata-001-7`.\n:::\n"
+    assert len(erratum_note_problems(box, labels)) == 2
+    unknown = good.replace("errata-001-7", "errata-009-1")
+    assert "inconnue" in " ".join(erratum_note_problems(unknown, labels))
+    no_link = good.replace("{ref}`001-7 <errata-001-7>`", "001-7")
+    assert "sans lien" in " ".join(erratum_note_problems(no_link, labels))
+    two_lines = good.replace("$\\Phi$.\n", "$\\Phi$,\ncomme l'explique l'annexe.\n")
+    assert "plusieurs lignes" in " ".join(erratum_note_problems(two_lines, labels))
+    long = good.replace("le support écrit", "le support écrit " + "vraiment " * 30)
+    assert "trop longue" in " ".join(erratum_note_problems(long, labels))
+    uncalled = good.replace("étape 3.[^e1]", "étape 3.")
+    assert "jamais appelée" in " ".join(erratum_note_problems(uncalled, labels))
+
+
 @pytest.mark.parametrize("chapter", ALL_CHAPTERS)
-def test_erratum_boxes_are_short_and_link_to_the_appendix(chapter):
+def test_errata_are_one_line_footnotes_that_link_to_the_appendix(chapter):
     text = (BOOK / f"{chapter}.md").read_text()
-    labels = _errata_labels()
-    for box in re.findall(r":::\{admonition\} Erratum[^\n]*\n:class: warning\n(.*?)\n:::", text, re.S):
-        links = re.findall(r"\{ref\}`(errata-[\w-]+)`", box)
-        assert links, f"{chapter} : encadré Erratum sans lien vers l'annexe : {box[:80]}"
-        assert set(links) <= labels, f"{chapter} : lien(s) inconnu(s) {set(links) - labels}"
-        assert len(box) < 900, f"{chapter} : encadré trop long ({len(box)} caractères) : {box[:80]}"
+    problems = erratum_note_problems(text, _errata_labels())
+    assert not problems, f"{chapter} : " + " ; ".join(problems)
     # aucun renvoi à des documents ou numéros de ligne que l'étudiant n'a pas
     prose = re.sub(r"```\{code-cell\}.*?```", "", text, flags=re.S)
     assert not re.search(r"\bl\.\s*\d|ALGORITHMS|\.txt\b", prose), chapter

@@ -44,7 +44,7 @@ CHROMIUM_ARGS = [
 # page_errors vérifie qu'il n'en reste qu'une.)
 
 #: Annexes du livre (ni figure à curseurs, ni quiz).
-APPENDICES = {"references", "errata"}
+APPENDICES = {"references", "errata", "glossaire"}
 
 #: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet, depuis son registre).
 EXPECTED_GRIDS = {name: (lambda name=name: ki.slider_grid(name)) for name in ki.slider_names()}

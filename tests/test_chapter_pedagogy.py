@@ -19,7 +19,7 @@ BOOK = ROOT / "book"
 
 
 #: Annexes du livre (ni objectifs, ni figure à curseurs, ni quiz).
-APPENDICES = {"references", "errata"}
+APPENDICES = {"references", "errata", "glossaire"}
 #: Travaux dirigés (papier et crayon) et travaux pratiques (l'étudiant écrit le code, le correcteur
 #: répond) : pas de figure à curseurs — l'interactivité d'un TD est le calcul à la main, celle d'un TP le
 #: code de l'étudiant et le verdict de practice.check. Objectifs, « À retenir » et quiz restent exigés.

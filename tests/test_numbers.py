@@ -204,12 +204,21 @@ def test_bokeh_tick_formatter_runs_in_javascript():
     node = shutil.which("node")
     if node is None:
         pytest.fail("Node.js introuvable : il est requis pour la construction (mermaid-cli).")
-    code = bokeh_tick_formatter().code
+    def run(formatter, ticks):
+        # Bokeh passe les « args » du formateur comme variables nommées du code
+        names = ", ".join(formatter.args)
+        values = ", ".join(json.dumps(v) for v in formatter.args.values())
+        script = (f"const f = (tick, {names}) => {{ {formatter.code} }};\n"
+                  f"console.log(JSON.stringify({json.dumps(ticks)}.map(t => f(t, {values}))));")
+        return json.loads(subprocess.run([node, "-e", script], capture_output=True, text=True, check=True).stdout)
+
     ticks = [0, 0.5, -0.25, 2, 1500, 25000, 1e-5, 3.5e-7, 2.5e7, -1e-4]
-    script = f"const f = (tick) => {{ {code} }};\nconsole.log(JSON.stringify({json.dumps(ticks)}.map(f)));"
-    out = subprocess.run([node, "-e", script], capture_output=True, text=True, check=True).stdout
-    assert json.loads(out) == ["0", "0,5", f"{M}0,25", "2", f"1{NN}500", f"25{NN}000", f"1{NN}×{NN}10⁻⁵",
-                               f"3,5{NN}×{NN}10⁻⁷", f"2,5{NN}×{NN}10⁷", f"{M}1{NN}×{NN}10⁻⁴"]
+    assert run(bokeh_tick_formatter(), ticks) == [
+        "0", "0,5", f"{M}0,25", "2", f"1{NN}500", f"25{NN}000", f"1{NN}×{NN}10⁻⁵",
+        f"3,5{NN}×{NN}10⁻⁷", f"2,5{NN}×{NN}10⁷", f"{M}1{NN}×{NN}10⁻⁴"]
+    # un axe d'années : sans séparateur de milliers
+    assert run(bokeh_tick_formatter(group_thousands=False), [1871, 1880, 1960, 1970.5]) == [
+        "1871", "1880", "1960", "1970,5"]
 
 
 def test_glue_number_accepts_a_python_spec(monkeypatch):
@@ -221,3 +230,10 @@ def test_glue_number_accepts_a_python_spec(monkeypatch):
     assert glued == {"rel": f"1,3{NN}%"}
     with pytest.raises(kc.KalmanInputError, match="pas les deux"):
         glue_number("x", 1.0, spec=".1f", decimals=2)
+
+
+def test_year_axes_of_the_slider_figures_have_no_thousands_separator():
+    from kalman_course.interactive.static import _is_year_axis
+
+    assert _is_year_axis("année") and _is_year_axis("années (1871–1970)")
+    assert not _is_year_axis("temps (s)") and not _is_year_axis("débit (10⁸ m³ par an)")

@@ -50,7 +50,8 @@ def _slider_figures() -> int:
 
 
 def _title(doc: str) -> str:
-    return re.search(r"(?m)^# (.+)$", (ROOT / f"{doc}.md").read_text()).group(1).strip()
+    """Le titre du chapitre tel qu'imprimé (sans le balisage d'italique : « *unscented* » → « unscented »)."""
+    return re.sub(r"\*([^*]+)\*", r"\1", re.search(r"(?m)^# (.+)$", (ROOT / f"{doc}.md").read_text()).group(1).strip())
 
 
 def _flat(text: str) -> str:
@@ -168,9 +169,11 @@ def test_exercises_come_with_their_solutions(pdf_build):
     n_solutions = sum((ROOT / f"{d}.md").read_text().count("```{solution-start}") for d in _toc_docs())
     flat = pdf_build["flat"]
     assert n_solutions == n_exercises
-    assert len(re.findall(r"(?<!Solution de )Exercice \d+", flat)) >= n_exercises
-    # sphinx-exercise en français : « Solution de Exercice 3 », suivie du texte et du code de la solution
-    assert len(re.findall(r"Solution de Exercice \d+", flat)) == n_solutions
+    assert len(re.findall(r"Exercice \d+", flat)) >= n_exercises
+    # sphinx-exercise (exercise_style: solution_follow_exercise) : la solution suit son exercice, titrée
+    # « Solution » ; jamais « Solution de Exercice 3 »
+    assert "Solution de Exercice" not in flat
+    assert len(re.findall(r"\\begin\{sphinxadmonition\}\{note\}\{Solution\}", pdf_build["tex"])) == n_solutions
 
 
 def test_bibliography_is_printed(pdf_build):
@@ -181,3 +184,15 @@ def test_bibliography_is_printed(pdf_build):
 
 def test_pdf_build_leaves_the_user_build_untouched(pdf_build, user_build_before):
     assert tree_state(ROOT / "_build") == user_build_before
+
+
+def test_contents_numbers_do_not_run_into_titles_and_parts_are_the_book_parts(pdf_build):
+    """Table des matières : « 13.10 Quiz », jamais « 13.10Quiz » ; les seules parties (\\part) sont celles
+    de _toc.yml (les réponses du quiz de l'introduction n'en deviennent pas une)."""
+    text = pdf_build["text"]
+    contents = text[: text.find(_title(_toc_docs()[1]), text.find(_title(_toc_docs()[1])) + 1)]
+    assert not re.search(r"\b\d+\.\d+[A-Za-zÀ-ÿ]", contents), re.findall(r"\b\d+\.\d+[A-Za-zÀ-ÿ]\S*", contents)[:5]
+    parts = re.findall(r"\\part\{([^}]*)\}", pdf_build["tex"])
+    captions = [p["caption"] for p in yaml.safe_load((ROOT / "_toc.yml").read_text())["parts"]]
+    assert len(parts) == len(captions), parts
+    assert "Réponses du quiz" not in parts

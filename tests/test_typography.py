@@ -6,7 +6,7 @@ from __future__ import annotations
 from docutils import nodes
 from docutils.core import publish_doctree
 
-from kalman_course.sphinx.typography import typeset
+from kalman_course.sphinx.typography import italicize_latin, typeset, typeset_mermaid
 from kalman_course.typography import french_spacing
 
 NB, NN = "\u00a0", "\u202f"
@@ -47,3 +47,33 @@ def test_typeset_skips_code_math_and_raw():
     assert "print('a : b')" in text
     assert "<b>brut : 'x'</b>" in text
     assert text.rstrip().endswith("brut : 'x'</b>")
+
+
+def test_latin_phrases_are_italicised_in_running_text_only():
+    doc = publish_doctree(
+        "L'estimation a priori, puis a posteriori, et l'a priori ; *a priori* déjà en italique.\n\n"
+        "Code : ``a priori`` et :math:`\\text{a priori}` ; le mot « apriorisme » et « la priori ».\n",
+        settings_overrides={"report_level": 5},
+    )
+    assert italicize_latin(doc) == 3
+    emphasised = [n.astext() for n in doc.findall(nodes.emphasis)]
+    assert emphasised == ["a priori", "a posteriori", "a priori", "a priori"]
+    assert "a priori" in [n.astext() for n in doc.findall(nodes.literal)]  # code intact
+    assert "\\text{a priori}" in [n.astext() for n in doc.findall(nodes.math)]
+    assert doc.astext().startswith("L'estimation a priori, puis a posteriori, et l'a priori ;")
+    assert italicize_latin(doc) == 0  # une seconde passe ne change rien
+
+
+def test_mermaid_labels_get_the_same_typography_but_not_the_syntax():
+    doc = publish_doctree("Texte.\n", settings_overrides={"report_level": 5})
+    node = nodes.Element()
+    node.tagname = "mermaid"
+    node["code"] = ('flowchart TB\n    K0["on fait confiance<br/>au <b>MODÈLE</b> : x̂ ≈ x̂⁻ a priori"]\n'
+                    '    A["Matrice d\'état A"] -->|"n ← n+1 ; suite"| B\n    style K0 fill:#c8e6c9,stroke:#388e3c\n')
+    doc += node
+    assert typeset_mermaid(doc) == 1
+    assert f"<b>MODÈLE</b>{NB}: x̂" in node["code"] and "Matrice d’état A" in node["code"]
+    assert "x̂⁻ <i>a priori</i>" in node["code"]
+    assert f"n+1{NN}; suite" in node["code"]
+    assert "style K0 fill:#c8e6c9,stroke:#388e3c" in node["code"]  # la syntaxe ne change pas
+    assert typeset_mermaid(doc) == 0

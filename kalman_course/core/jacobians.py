@@ -119,14 +119,14 @@ class JacobianCheck:
         return self.ok
 
     def __repr__(self) -> str:
-        from ..numbers import format_spec  # nombres écrits à la française (import local : pas de cycle)
+        from ..numbers import format_number, format_spec  # à la française (import local : pas de cycle)
 
         i, j = self.worst
         verdict = "correcte" if self.ok else "FAUSSE"
         return (
             f"Jacobienne « {self.name} » : {verdict}\n"
-            f"  écart relatif max {format_spec(self.max_rel_error, '.1e')} "
-            f"(tolérance {format_spec(self.rtol, '.0e')})\n"
+            f"  écart relatif max {format_number(self.max_rel_error, significant=2)} "
+            f"(tolérance {format_number(self.rtol, significant=1)})\n"
             f"  pire élément ({i}, {j}) : analytique {format_spec(self.analytic[i, j], '.6g')} ; "
             f"différences finies {format_spec(self.numerical[i, j], '.6g')}"
         )

@@ -14,7 +14,7 @@ from . import consistency  # noqa: F401  (chapitre « Vérifier les hypothèses 
 from . import ekf  # noqa: F401  (chapitre « Dynamique non linéaire — le filtre de Kalman étendu »)
 from . import tag  # noqa: F401  (chapitre « Exemple — suivi d'un tag radio (UWB) »)
 from . import iekf  # noqa: F401  (chapitre « Filtre de Kalman étendu itéré »)
-from . import unscented  # noqa: F401  (chapitre « Le filtre de Kalman sans parfum (UKF) »)
+from . import unscented  # noqa: F401  (chapitre « Le filtre de Kalman *unscented* (UKF) »)
 from . import particle  # noqa: F401  (chapitre « Le filtre particulaire »)
 from . import ensemble  # noqa: F401  (chapitre « Le filtre de Kalman d'ensemble (EnKF) »)
 from . import srif  # noqa: F401  (chapitre « Filtre d'information en racine carrée (SRIF) »)

@@ -27,7 +27,7 @@ CHAPTER_TITLES: dict[str, str] = {
     "ekf": "Dynamique non linéaire — le filtre de Kalman étendu",
     "suivi-tag": "Exemple — suivi d'un tag radio (UWB)",
     "ekf-itere": "Filtre de Kalman étendu itéré",
-    "ukf": "Le filtre de Kalman sans parfum (UKF)",
+    "ukf": "Le filtre de Kalman *unscented* (UKF)",
     "filtre-particulaire": "Le filtre particulaire",
     "enkf": "Le filtre de Kalman d'ensemble (EnKF)",
     "lissage": "Lissage : le lisseur de Rauch–Tung–Striebel",

@@ -34,7 +34,7 @@ def iekf_iterations():
     tl = it.table_literal
     ax.plot(tl[:, 0], tl[:, 1], ":", color="tab:purple", lw=1.2)
     ax.plot(*tl[-1], "D", color="tab:purple", ms=6, label="tableau des notes (limite)")
-    ax.plot(*it.map, "*", color="k", ms=11, label="MAP (least_squares)")
+    ax.plot(*it.map, "*", color="k", ms=11, label="MAP (optimiseur indépendant)")
     ax.plot(*p.truth, "x", color="tab:green", ms=9, mew=2, label="cible vraie")
     ax.set_xlim(xs[0], xs[-1])
     ax.set_ylim(ys[0], ys[-1])

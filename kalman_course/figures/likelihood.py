@@ -23,9 +23,9 @@ from ._registry import new_figure, register
 from .smoothing import FILTER_COLOR, SMOOTHER_COLOR, french_axes, log_axis
 
 CHAPTER = "vraisemblance"
-FLOW = "débit annuel (10⁸ m³)"
+FLOW = "débit (10⁸ m³ par an)"
 
-#: Valeurs de :math:`\kappa` de la figure du départ diffus approché.
+#: Valeurs de :math:`\kappa` de la figure de l'initialisation diffuse approchée.
 KAPPAS = 10.0 ** np.arange(2, 18)
 
 
@@ -74,7 +74,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return out
 
 
-@register("vraisemblance-diffus", chapter=CHAPTER, title="Départ diffus : l'a priori large et sa limite exacte")
+@register("vraisemblance-diffus", chapter=CHAPTER, title="Initialisation diffuse : l'a priori large et sa limite exacte")
 def diffuse_start():
     model = local_level_model(*NILE_DK_VARIANCES)
     exact = log_likelihood(model, nile().flow)
@@ -119,7 +119,7 @@ def likelihood_surface_figure():
     ax.set_yscale("log")
     ax.set_xlabel(r"$R = \sigma^2_\varepsilon$ (10¹⁶ m⁶)")
     ax.set_ylabel(r"$Q = \sigma^2_\eta$ (10¹⁶ m⁶)")
-    ax.set_title(r"Courbes de niveau de $\log L - \log L_{\max}$ (nats), départ diffus exact")
+    ax.set_title(r"Courbes de niveau de $\log L - \log L_{\max}$ (nats), initialisation diffuse exacte")
     decades(ax.xaxis)
     decades(ax.yaxis)
     ax.legend(fontsize=8, loc="lower left", framealpha=0.9)
@@ -132,7 +132,7 @@ def nile_level():
     run = nile_smoothing(False)
     drop = level_drop(run)
     fig, ax = new_figure(width=7.5, height=4.0)
-    _level_panel(ax, run, "Niveau local au maximum de vraisemblance (départ diffus exact)")
+    _level_panel(ax, run, "Niveau local au maximum de vraisemblance (initialisation diffuse exacte)")
     year = drop["year"]
     at = float(run.smoothed.x[run.data.year == year, 0][0])
     ax.axvline(year, color="0.3", lw=1, ls="--")

@@ -4,15 +4,52 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.stats
+from matplotlib.colors import PowerNorm
 
 from ..filters.particle import RESAMPLING_SCHEMES
 from ..numbers import format_number
 from ..scenarios import growth
+from ..scenarios.grid_bayes import bimodal_step, growth_grid_posteriors
 from ..scenarios.convergence import particle_convergence
 from ..scenarios.importance import degeneracy, importance_example
 from ._registry import new_figure, register
 
 CHAPTER = "filtre-particulaire"
+
+
+@register("pf-grille", chapter=CHAPTER,
+          title="Le filtre bayésien exact sur une grille : loi a posteriori à deux modes du modèle de croissance")
+def pf_grid():
+    data = growth.growth_data()
+    post = growth_grid_posteriors()
+    runs = growth.growth_filters(data)
+    k = bimodal_step(post)
+    fig, (ax, ad) = new_figure(2, 1, width=8.0, height=6.4, gridspec_kw={"height_ratios": [1.3, 1]})
+    dx = post.grid[1] - post.grid[0]
+    # échelle de couleur en puissance 0,4 : les modes secondaires, moins hauts, restent visibles
+    ax.imshow(post.density.T, origin="lower", aspect="auto", cmap="Blues",
+                      extent=(data.t[0] - 0.5, data.t[-1] + 0.5, post.grid[0] - dx / 2, post.grid[-1] + dx / 2),
+                      norm=PowerNorm(gamma=0.4, vmin=0.0, vmax=float(post.density.max())))
+    ax.plot(data.t, data.x_true[:, 0], "k.-", lw=0.8, ms=4, label="état vrai")
+    ax.axvline(data.t[k], color="tab:red", lw=1.0, ls=":", label=f"pas {int(data.t[k])} (en bas)")
+    ax.set_ylim(-26.0, 26.0)
+    ax.set_xlabel("pas de temps k")
+    ax.set_ylabel("état x (sans unité)")
+    ax.set_title(r"Densité a posteriori exacte $p(x_k \mid y_{1:k})$ (plus foncé : plus probable)", fontsize=10)
+    ax.legend(fontsize=7, loc="lower left")
+    ad.plot(post.grid, post.density[k], color="tab:blue", lw=1.8, label="filtre bayésien sur grille (exact)")
+    for name, color, ls in (("EKF", "tab:red", "--"), ("UKF", "tab:orange", "-.")):
+        m, s = runs[name].x[k, 0], np.sqrt(runs[name].P[k, 0, 0])
+        ad.plot(post.grid, scipy.stats.norm.pdf(post.grid, m, s), ls, color=color, lw=1.4,
+                label=f"gaussienne de l'{name}")
+    ad.axvline(data.x_true[k, 0], color="k", lw=1.5, label="état vrai")
+    ad.set_xlim(-26.0, 26.0)
+    ad.set_xlabel("état x (sans unité)")
+    ad.set_ylabel("densité (sans unité)")
+    ad.set_title(f"Au pas {int(data.t[k])} : deux modes, de part et d'autre de 0", fontsize=10)
+    ad.legend(fontsize=7, loc="upper left")
+    ad.grid(alpha=0.3)
+    return fig
 
 
 @register("pf-importance", chapter=CHAPTER,
@@ -111,7 +148,7 @@ def pf_growth():
     rmse = {name: np.sqrt(np.mean((r.x[:, 0] - data.x_true[:, 0]) ** 2)) for name, r in runs.items()}
     for name, color, ls in (("EKF", "tab:red", "--"), ("UKF", "tab:orange", "-."), ("filtre particulaire", "tab:blue", "-")):
         ax.plot(data.t, runs[name].x[:, 0], ls, color=color, lw=1.3,
-                label=f"{name} (erreur quadratique moyenne {format_number(rmse[name], decimals=1)})")
+                label=f"{name} (REQM {format_number(rmse[name], decimals=1)})")
     ax.set_ylabel("état x (sans unité)")
     ax.set_xlabel("pas de temps k")
     ax.legend(fontsize=7, loc="lower left", ncol=2)
@@ -145,9 +182,9 @@ def pf_convergence():
     N = conv.sizes
     fig, ax = new_figure(width=7.0, height=3.8)
     ax.loglog(N, conv.mean_error, "o-", color="tab:blue",
-              label=f"moyenne : ‖x̂ − x̂_KF‖ (pente {format_number(conv.mean_slope, decimals=2)})")
+              label=r"moyenne : $\|\hat x - \hat x_{\mathrm{KF}}\|$" + f" (pente {format_number(conv.mean_slope, decimals=2)})")
     ax.loglog(N, conv.cov_error, "s-", color="tab:orange",
-              label=f"covariance : ‖P − P_KF‖ (pente {format_number(conv.cov_slope, decimals=2)})")
+              label=r"covariance : $\|P - P_{\mathrm{KF}}\|$" + f" (pente {format_number(conv.cov_slope, decimals=2)})")
     ax.loglog(N, conv.loglik_error, "^-", color="tab:green", label="log-vraisemblance (nats)")
     ax.loglog(N, conv.mean_error[0] * np.sqrt(N[0] / N), "k:", label="pente −1/2")
     ax.set_xlabel("nombre de particules N (sans unité)")

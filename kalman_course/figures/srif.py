@@ -14,7 +14,7 @@ _FLOOR = 1e-16
 
 
 @register("srif-depart-diffus", chapter=CHAPTER,
-          title="Départ sans a priori : filtre de Kalman avec P0 = 10^k I contre SRIF parti de R_xx = 0")
+          title="Initialisation sans a priori : filtre de Kalman avec P₀ = 10ᵏ I contre SRIF parti d'une information nulle")
 def srif_diffuse_start():
     err = diffuse_errors()
     fig, (ax, at) = new_figure(2, 1, width=7.5, height=8.0)

@@ -44,7 +44,7 @@ def tag_track():
     ax.plot(*data.x0[:2], "o", color="tab:blue", mfc="white", ms=8, label=r"départ du filtre $\hat x_0$")
     ax.plot(*data.x_true[0, :2], "s", color="tab:green", ms=7, label="départ du tag")
     ax.set_title(f"Tag UWB, {data.t[-1]:.0f} s, 4 ancres, $\\sigma_r$ = 10 cm : "
-                 f"erreur quadratique moyenne {fr(100 * rmse, '.1f')} cm")
+                 f"REQM {fr(100 * rmse, '.1f')} cm")
     ax.legend(loc="upper center", fontsize=8, ncol=3, bbox_to_anchor=(0.5, -0.1))
     return fig
 

@@ -1,4 +1,4 @@
-"""Figures du chapitre « Le filtre de Kalman sans parfum (UKF) »."""
+"""Figures du chapitre « Le filtre de Kalman *unscented* (UKF) »."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ COLORS = {"truth": "k", "linearized": "tab:red", "unscented": "tab:blue"}
 
 
 @register("ukf-banane", chapter=CHAPTER,
-          title="La « banane » : loi polaire vue en cartésien — vérité, linéarisation, transformée sans parfum")
+          title="La « banane » : loi polaire vue en cartésien — vérité, linéarisation, transformée unscented")
 def ukf_banana():
     comp = banana.banana_comparison()
     polar = banana.banana_polar_sample(3000)
@@ -43,7 +43,7 @@ def ukf_banana():
     for key, mom, label in (
         ("truth", comp.truth, "vérité (forme close)"),
         ("linearized", comp.linearized, f"linéarisation (EKF) : moyenne à {format_number(100 * e_lin, decimals=1)} cm"),
-        ("unscented", comp.unscented, f"sans parfum (UKF) : moyenne à {format_number(1000 * e_ut, significant=2)} mm"),
+        ("unscented", comp.unscented, f"transformée unscented (UKF) : moyenne à {format_number(1000 * e_ut, significant=2)} mm"),
     ):
         draw_ellipse(ax1, mom.mean, mom.cov, 2.0, color=COLORS[key], lw=1.8, ls="--" if key == "truth" else "-",
                      label=f"{label} (2σ)")
@@ -91,7 +91,7 @@ def ukf_orders():
     stds = np.logspace(np.log10(0.02), np.log10(0.6), 15)
     errors = banana.mean_error_orders(stds)
     fig, ax = new_figure(width=7.0, height=3.8)
-    labels = ("linéarisation (EKF) : pente 2", "sans parfum, κ = 0 : pente 4", "sans parfum, κ = 3 − n = 1 : pente 6")
+    labels = ("linéarisation (EKF) : pente 2", "unscented, κ = 0 : pente 4", "unscented, κ = 3 − n = 1 : pente 6")
     for e, label, color in zip(errors, labels, ("tab:red", "tab:blue", "tab:green")):
         ax.loglog(np.rad2deg(stds), 1000 * e, "o-", ms=3, color=color, label=label)
     ax.set_xlabel("écart-type de l'azimut σθ (°)")
@@ -130,9 +130,9 @@ def ukf_comparison():
     data, gap = run.data, run.gap
     fig, (ax, ad) = new_figure(2, 1, width=7.5, height=5.2, sharex=True)
     ax.plot(data.t, 100 * run.ekf_error, color="tab:red", lw=1.4,
-            label=f"EKF (erreur quadratique moyenne {format_number(100 * run.ekf_rmse, decimals=2)} cm)")
+            label=f"EKF (REQM {format_number(100 * run.ekf_rmse, decimals=2)} cm)")
     ax.plot(data.t, 100 * run.ukf_error, color="tab:blue", lw=1.0, ls="--",
-            label=f"UKF (erreur quadratique moyenne {format_number(100 * run.ukf_rmse, decimals=2)} cm)")
+            label=f"UKF (REQM {format_number(100 * run.ukf_rmse, decimals=2)} cm)")
     ax.axvspan(0, data.t[TAG_TRANSIENT_STEPS - 1], color="0.85", label="régime transitoire (exclu)")
     ax.set_ylim(0, 30)
     ax.set_ylabel(r"erreur de position $\|\hat p - p\|$ (cm)")

@@ -5,7 +5,8 @@ dans un :class:`FilterFamily` :
 
 * ``prior(model, x0, P0)`` → état interne initial (vérifie ``x0``, ``P0`` et les convertit : par exemple
   :math:`(\hat x_0, P_0)`, ou :math:`(\mathcal R_{xx}, z_x)` pour le SRIF) ;
-* ``predict(model, state, u_k)`` → état prédit (:math:`k-1 \mid k-1 \to k \mid k-1`) ;
+* ``predict(model, state, u_k)`` → état prédit (:math:`k-1 \mid k-1 \to k \mid k-1`), avec la ligne ``u[k]``
+  des commandes, qui contient :math:`u_{k-1}` (convention du livre : :math:`x_k = f(x_{k-1}, u_{k-1})`) ;
 * ``update(model, state, y_k, idx)`` → ``(état corrigé, Correction)``, où ``y_k`` ne contient que les
   composantes observées et ``idx`` leurs indices (``None`` : toutes) ;
 * ``moments(state)`` → :math:`(\hat x, P)` à ranger dans le résultat.

@@ -250,7 +250,7 @@ def kalman_filter_runs(
     Sans mesure manquante et avec un :math:`P_0` commun, la récurrence des covariances
     :math:`P_{k\mid k-1}, S_k, K_k, P_{k\mid k}` ne dépend pas des mesures : le moteur la calcule **une
     fois** pour tous les tirages, et seule la moyenne est propagée en lot,
-    :math:`\hat X_{k\mid k-1} = \hat X_{k-1\mid k-1}A^T + (Bu_k)^T`,
+    :math:`\hat X_{k\mid k-1} = \hat X_{k-1\mid k-1}A^T + (Bu_{k-1})^T`,
     :math:`\hat X_{k\mid k} = \hat X_{k\mid k-1} + (Y_k - \hat X_{k\mid k-1}C^T)K_k^T` (une ligne par
     tirage). Avec des mesures manquantes (``NaN``, tirage par tirage) ou un :math:`P_0` par tirage, chaque
     tirage garde sa covariance ; à chaque pas, les tirages qui ont le même motif de composantes observées

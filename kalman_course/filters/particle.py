@@ -7,7 +7,7 @@ gardés en **logarithme** (aucun poids ne s'annule par soupassement, même avec 
 * a priori : :math:`x^i_0 \sim \mathcal N(\hat x_0, P_0)`, :math:`w^i_0 = 1/N` ;
 * prédiction (la loi de transition sert de loi de proposition) : si
   :math:`\mathrm{ESS} = 1/\sum_i (w^i)^2 < \tau N`, rééchantillonnage (indices tirés selon les poids,
-  poids remis à :math:`1/N`), puis :math:`x^i_k = f(x^i_{k-1}, u_k) + w^i`, :math:`w^i \sim \mathcal N(0, Q)` ;
+  poids remis à :math:`1/N`), puis :math:`x^i_k = f(x^i_{k-1}, u_{k-1}) + w^i` (:math:`u_{k-1}` : ligne ``u[k]``), :math:`w^i \sim \mathcal N(0, Q)` ;
 * correction : :math:`\log\tilde w^i = \log w^i + \log\mathcal N(y_k;\,h(x^i_k),\,R)`, puis
   normalisation par log-somme-exp ; l'incrément de log-vraisemblance est
   :math:`\log\hat p(y_k\mid y_{1:k-1}) = \log\sum_i w^i\,\mathcal N(y_k;\,h(x^i_k),\,R)`.

@@ -476,8 +476,8 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
     itéré, dont la prédiction est la même).
 
     :math:`A` devient la jacobienne de la prédiction du filtre,
-    :math:`F_k = \partial f/\partial x\,(\hat x_{k\mid k}, u_{k+1})` (la ligne ``k+1`` est prédite avec
-    ``u[k+1]``) :
+    :math:`F_k = \partial f/\partial x\,(\hat x_{k\mid k}, u_k)` (la ligne ``k+1`` est prédite avec
+    ``u[k+1]``, qui contient :math:`u_k`) :
 
     .. math::
 
@@ -549,7 +549,7 @@ def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha
     :func:`~kalman_course.unscented_kalman_filter`, avec les mêmes paramètres :math:`(\alpha, \beta, \kappa)`.
 
     Pour :math:`k = T-2, \dots, 0` : points sigma :math:`\chi_i` de :math:`(\hat x_{k\mid k}, P_{k\mid k})`,
-    images :math:`\chi_i^f = f(\chi_i, u_{k+1})`, puis
+    images :math:`\chi_i^f = f(\chi_i, u_k)` (:math:`u_k` : ligne ``u[k+1]``), puis
 
     .. math::
 

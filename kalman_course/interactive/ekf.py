@@ -2,7 +2,7 @@ r"""Curseurs du chapitre « Le filtre de Kalman étendu » : une loi gaussienne 
 coordonnées cartésiennes.
 
 :func:`~kalman_course.scenarios.polar.polar_transform` : nuage de Monte-Carlo, moyenne et covariance
-exactes (empiriques) et approximation de l'EKF (tangente). Les curseurs changent l'incertitude d'azimut
+exactes (forme close) et approximation de l'EKF (tangente). Les curseurs changent l'incertitude d'azimut
 :math:`\sigma_\theta` et de distance :math:`\sigma_r` ; la position par défaut (20°, 0,5 m) est la figure
 de linéarisation du chapitre. En haut, le croissant et l'ellipse de l'EKF ; en bas, la fonction
 :math:`x = r\cos\theta` et sa tangente en :math:`\hat\theta = 0`.

@@ -101,7 +101,7 @@ def iekf_spec() -> SliderSpec:
                     Glyph("path_y", "scatter", "royalblue", "", x="path_x", marker="circle", size=6),
                     Glyph("ekf_y", "scatter", "firebrick", "EKF = x⁽¹⁾", x="ekf_x", marker="square", size=12,
                           alpha=0.7),
-                    Glyph("map_y", "scatter", "black", "MAP (least_squares)", x="map_x", marker="star", size=16),
+                    Glyph("map_y", "scatter", "black", "MAP (optimiseur indépendant)", x="map_x", marker="star", size=16),
                     Glyph("truth_y", "scatter", "seagreen", "cible vraie", x="truth_x", marker="x", size=12),
                     Glyph("now_y", "scatter", "crimson", "itéré choisi", x="now_x", marker="circle", size=12),
                 ),
@@ -113,7 +113,7 @@ def iekf_spec() -> SliderSpec:
             ),
             Panel(
                 "Distance au MAP à chaque itération",
-                "‖x⁽ⁱ⁾ − x_MAP‖ (m)",
+                "distance de l'itéré au MAP (m)",
                 (
                     Glyph("distance", "line", "royalblue", "Gauss–Newton"),
                     Glyph("distance", "scatter", "royalblue", "", marker="circle", size=6),

@@ -1,7 +1,7 @@
 r"""Curseurs du chapitre « Apprendre Q et R » : la vraisemblance du Nil au curseur.
 
 Pour :math:`R = \sigma^2_\varepsilon` et :math:`Q = \sigma^2_\eta` choisis, le logarithme de la vraisemblance
-(départ diffus exact, :func:`~kalman_course.log_likelihood`) le long de :math:`Q` à :math:`R` fixé, avec le
+(initialisation diffuse exacte, :func:`~kalman_course.log_likelihood`) le long de :math:`Q` à :math:`R` fixé, avec le
 maximum de vraisemblance (:func:`~kalman_course.scenarios.nile.nile_fit`), et les innovations
 normalisées du filtre, qui doivent ressembler à un bruit :math:`\mathcal N(0, 1)` au bon réglage. Position
 par défaut : les variances publiées par Durbin & Koopman, celles du chapitre.
@@ -31,7 +31,7 @@ PROFILE_Q = np.logspace(0.0, 5.5, 45)
 
 @lru_cache(maxsize=None)
 def _profile(R: float) -> np.ndarray:
-    """:math:`\\log L(R, Q)` pour chaque :math:`Q` de :data:`PROFILE_Q` (départ diffus exact, Nil complet)."""
+    """:math:`\\log L(R, Q)` pour chaque :math:`Q` de :data:`PROFILE_Q` (initialisation diffuse exacte, Nil complet)."""
     y = nile(False).flow
     return np.array([log_likelihood(local_level_model(R, q), y) for q in PROFILE_Q])
 
@@ -89,14 +89,14 @@ def likelihood_spec() -> SliderSpec:
                     Glyph("ll_hat", "scatter", "black", "maximum de vraisemblance", x="Q_hat", marker="star",
                           size=15),
                 ),
-                x_label="Q = σ²η ((10⁸ m³)²)",
+                x_label="Q = σ²η ((10⁸ m³ par an)²)",
                 x_range=(float(PROFILE_Q[0]), float(PROFILE_Q[-1])),
                 x_log=True,
                 y_range=(float(fit.log_likelihood) - 40.0, float(fit.log_likelihood) + 3.0),
                 height=260,
             ),
             Panel(
-                "Innovations normalisées du filtre (départ diffus exact)",
+                "Innovations normalisées du filtre (initialisation diffuse exacte)",
                 "ν / √S (sans unité)",
                 (
                     Glyph("", "hline", "gray", "± 2", value=2.0, dash="dashed", width=1.0),

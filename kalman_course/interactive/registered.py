@@ -1,5 +1,5 @@
 r"""Au registre des figures à curseurs : les figures écrites avant lui pour les chapitres « Le filtre de
-Kalman sans parfum (UKF) », « Le filtre particulaire » et « Lissage ».
+Kalman *unscented* (UKF) », « Le filtre particulaire » et « Lissage ».
 
 Chaque entrée reprend les axes, la fonction d'une exécution, les panneaux et les séries fixes de la
 figure d'origine (:mod:`.unscented`, :mod:`.particle`, :mod:`.smoothing`) : même grille, mêmes tracés ;
@@ -70,7 +70,7 @@ def nile_spec() -> SliderSpec:
     r"""Le Nil filtré et lissé : :math:`R` et :math:`Q` (grille de :func:`~.smoothing.nile_grid`)."""
     return SliderSpec(
         name="nil-curseurs", chapter="lissage",
-        title="Le Nil filtré et lissé : déplacez R et Q (niveau local, départ diffus exact)",
+        title="Le Nil filtré et lissé : déplacez R et Q (niveau local, initialisation diffuse exacte)",
         x_label="année", axes=nile_axes(), run=nile_slider_run,
         time=nile(True).year.astype(float), panels=nile_panels(), fixed={"y": nile(True).flow},
     )

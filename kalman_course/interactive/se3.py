@@ -112,7 +112,7 @@ def se3_spec() -> SliderSpec:
                 "Erreur d'orientation à chaque itération",
                 "angle (°)",
                 (
-                    Glyph("angle", "line", "royalblue", "angle de R_estᵀ R_vrai"),
+                    Glyph("angle", "line", "royalblue", "angle entre orientation estimée et vraie"),
                     Glyph("angle", "scatter", "royalblue", "", marker="circle", size=5),
                     Glyph("angle_now", "scatter", "crimson", "itération choisie", x="iteration_now",
                           marker="circle", size=11),
@@ -127,7 +127,7 @@ def se3_spec() -> SliderSpec:
                 "Erreur de position à chaque itération",
                 "distance (cm)",
                 (
-                    Glyph("position", "line", "seagreen", "‖t_est − t_vrai‖"),
+                    Glyph("position", "line", "seagreen", "distance entre position estimée et vraie"),
                     Glyph("position", "scatter", "seagreen", "", marker="circle", size=5),
                     Glyph("position_now", "scatter", "crimson", "itération choisie", x="iteration_now",
                           marker="circle", size=11),

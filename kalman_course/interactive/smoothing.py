@@ -1,7 +1,7 @@
 r"""Curseurs du chapitre « Lissage » : le Nil (années manquantes de Durbin & Koopman), filtré et lissé,
 pour des variances :math:`R = \sigma^2_\varepsilon` et :math:`Q = \sigma^2_\eta` choisies au curseur.
 
-Le modèle est le niveau local de :mod:`kalman_course.scenarios.nile`, au départ diffus exact. La position
+Le modèle est le niveau local de :mod:`kalman_course.scenarios.nile`, à l'initialisation diffuse exacte. La position
 par défaut des curseurs est l'estimation publiée par Durbin & Koopman,
 :math:`(\sigma^2_\varepsilon, \sigma^2_\eta) = (15\,099 ; 1\,469{,}1)` (:math:`(10^8` m³)²).
 """
@@ -19,7 +19,7 @@ from .spec import Glyph, Panel
 __all__ = ["nile_axes", "nile_slider_run", "nile_grid", "nile_panels", "nile_sliders", "live_nile_explorer"]
 
 LIVE_HINT = "kc.interactive.live_nile_explorer()"
-UNIT = "(10⁸ m³)²"
+UNIT = "(10⁸ m³ par an)²"
 
 
 def nile_axes(per_decade: int = 2) -> tuple[ParameterAxis, ParameterAxis]:
@@ -51,12 +51,12 @@ def nile_grid(per_decade: int = 2) -> ParameterGrid:
 def nile_panels() -> tuple[Panel, ...]:
     """La figure : débits et niveaux filtré et lissé, puis leurs écarts-types (échelle log)."""
     return (
-        Panel("Débit du Nil (années 1891–1910 et 1931–1950 retirées)", "débit (10⁸ m³)",
+        Panel("Débit du Nil (années 1891–1910 et 1931–1950 retirées)", "débit (10⁸ m³ par an)",
               (Glyph("y", "scatter", "firebrick", "débit mesuré"),
                Glyph("xf", "line", "darkorange", "niveau filtré"),
                Glyph("xs", "line", "royalblue", "niveau lissé")),
               y_range=(400.0, 1450.0), height=280),
-        Panel("Écart-type du niveau", "écart-type (10⁸ m³)",
+        Panel("Écart-type du niveau", "écart-type (10⁸ m³ par an)",
               (Glyph("sf", "line", "darkorange", "filtre"), Glyph("ss", "line", "royalblue", "lisseur")),
               y_log=True, y_range=(2.0, 2000.0)),
     )
@@ -74,7 +74,7 @@ def nile_sliders(per_decade: int = 2):
         x_label="année",
         fixed={"y": nile(True).flow},
         name="nil-curseurs",
-        title="Le Nil filtré et lissé : déplacez R et Q (niveau local, départ diffus exact)",
+        title="Le Nil filtré et lissé : déplacez R et Q (niveau local, initialisation diffuse exacte)",
         live_hint=LIVE_HINT,
     )
 

@@ -65,6 +65,13 @@ BOKEH_VERSION = bokeh.__version__
 PLOTTED_SOURCE = "kc-plotted"
 
 
+def _is_year_axis(label) -> bool:
+    """Vrai pour une abscisse d'années (libellé « année » ou « années », avec ou sans unité) : ses
+    graduations s'écrivent sans séparateur de milliers (« 1880 »)."""
+    text = label if isinstance(label, str) else ""
+    return text.split("(")[0].strip().lower() in {"année", "années", "an"}
+
+
 def bokehjs_files() -> list[str]:
     """Fichiers BokehJS nécessaires, relatifs à ``_static/`` : noyau puis composants (curseurs)."""
     return [f"bokeh/bokeh-{BOKEH_VERSION}.min.js", f"bokeh/bokeh-widgets-{BOKEH_VERSION}.min.js"]
@@ -310,7 +317,7 @@ class StaticSliders:
             fig.xaxis.axis_label = french_spacing(panel.x_label or self.x_label)
             fig.yaxis.axis_label = french_spacing(panel.y_label)
             # graduations en français (virgule décimale, × 10ⁿ), sur les axes linéaires et logarithmiques
-            fig.xaxis.formatter = bokeh_tick_formatter()
+            fig.xaxis.formatter = bokeh_tick_formatter(group_thousands=not _is_year_axis(fig.xaxis.axis_label))
             fig.yaxis.formatter = bokeh_tick_formatter()
             items = []
             for glyph in panel.glyphs:

@@ -31,8 +31,8 @@ def system_axes() -> tuple[ParameterAxis, ParameterAxis]:
         ParameterAxis(name, symbol, description, "", np.array(factors), default=factors.index(1.0),
                       scale="linear", tick_labels=tuple(f"× {number(k)}" for k in factors))
         for name, symbol, description, factors in (
-            ("phi_scale", "k_φ", "écarts-types du bruit d'état φ", STATE_FACTORS),
-            ("psi_scale", "k_ψ", "écart-type du bruit de mesure ψ", MEASUREMENT_FACTORS),
+            ("phi_scale", "facteur de φ", "multiplie les écarts-types du bruit d'état φ", STATE_FACTORS),
+            ("psi_scale", "facteur de ψ", "multiplie l'écart-type du bruit de mesure ψ", MEASUREMENT_FACTORS),
         )
     )
 

@@ -1,4 +1,4 @@
-r"""Curseurs du chapitre « Le filtre de Kalman sans parfum (UKF) » : la banane polaire.
+r"""Curseurs du chapitre « Le filtre de Kalman *unscented* (UKF) » : la banane polaire.
 
 Deux figures à curseurs statiques (Bokeh, exécutions précalculées à la construction du livre) :
 
@@ -131,16 +131,16 @@ def banana_parameter_grid() -> ParameterGrid:
 
 
 def banana_uncertainty_panels() -> tuple[Panel, ...]:
-    """Linéarisation (EKF) puis transformée sans parfum (UKF), chacune contre la vérité."""
+    """Linéarisation (EKF) puis transformée unscented (UKF), chacune contre la vérité."""
     return (
         _panel("Linéarisation (EKF) contre vérité — ellipses à 2σ", "lin", (-0.1, 1.35)),
-        _panel("Transformée sans parfum (UKF) contre vérité — ellipses à 2σ", "ut", (-0.1, 1.35)),
+        _panel("Transformée unscented (UKF) contre vérité — ellipses à 2σ", "ut", (-0.1, 1.35)),
     )
 
 
 def banana_parameter_panels() -> tuple[Panel, ...]:
-    """La transformée sans parfum contre la vérité (σθ = 20°, σᵣ = 2 cm)."""
-    return (_panel("Transformée sans parfum (UKF) contre vérité — ellipses à 2σ", "ut", (0.35, 1.3)),)
+    """La transformée unscented contre la vérité (σθ = 20°, σᵣ = 2 cm)."""
+    return (_panel("Transformée unscented (UKF) contre vérité — ellipses à 2σ", "ut", (0.35, 1.3)),)
 
 
 def banana_uncertainty_run(bearing_deg: float, range_std: float) -> dict[str, np.ndarray]:

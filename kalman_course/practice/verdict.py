@@ -19,7 +19,7 @@ _COLORS = {True: ("#1a7f37", "#e8f5ec", "#0b3318"), False: ("#b3261e", "#fdecea"
 
 def _french(text: str) -> str:
     """La typographie française (espaces insécables, apostrophe « ’ ») hors des `extraits de code`."""
-    from ..book_typography import french_spacing
+    from ..typography import french_spacing
 
     parts = re.split(r"(`[^`]*`)", text)
     return "".join(part if i % 2 else french_spacing(part) for i, part in enumerate(parts))

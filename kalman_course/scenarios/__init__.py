@@ -18,6 +18,7 @@ from . import growth, convergence, importance  # noqa: F401  (filtre particulair
 from . import labs  # noqa: F401  (travaux pratiques : le filtre de l'étudiant contre celui du paquet)
 from . import tutorials  # noqa: F401  (travaux dirigés : les exemples calculés à la main)
 from . import helicopter, manoeuvre  # noqa: F401  (pistage : l'hélicoptère SAMU 31, la cible qui manœuvre)
+from . import grid_bayes  # noqa: F401  (filtre bayésien exact sur une grille : le modèle de croissance)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
@@ -28,6 +29,7 @@ __all__ = [
     "growth",
     "helicopter",
     "manoeuvre",
+    "grid_bayes",
     "importance",
     "labs",
     "tutorials",

@@ -9,7 +9,8 @@ banc d'essai classique des filtres particulaires :
 La mesure ne voit que :math:`x_k^2` : :math:`x_k` et :math:`-x_k` l'expliquent aussi bien, et la loi a
 posteriori a souvent **deux modes**. Un filtre gaussien (EKF, UKF) n'en garde qu'un — souvent le mauvais —
 alors que le nuage de particules garde les deux. Le terme :math:`8\cos(1{,}2k)` est passé comme une
-commande :math:`u_k` (le modèle du paquet n'a pas de temps explicite).
+commande (le modèle du paquet n'a pas de temps explicite) : la ligne de :math:`y_k` porte :math:`8\cos(1{,}2\,k)`,
+la commande :math:`u_{k-1}` de la transition vers :math:`x_k`.
 """
 
 from __future__ import annotations
@@ -79,7 +80,7 @@ def growth_observation(x: Any) -> np.ndarray:
 
 
 def growth_controls(n_steps: int = GROWTH_STEPS) -> np.ndarray:
-    r"""Les « commandes » :math:`u_k = 8\cos(1{,}2\,k)`, :math:`k = 1\dots T`, forme (T, 1)."""
+    r"""Les « commandes » : ligne :math:`k` (:math:`k = 1\dots T`) :math:`8\cos(1{,}2\,k)`, terme de la transition vers :math:`x_k`, forme (T, 1)."""
     n_steps = check_positive_int("n_steps", n_steps)
     return 8.0 * np.cos(1.2 * np.arange(1, n_steps + 1))[:, None]
 

@@ -5,11 +5,14 @@ filtre de Kalman étendu »).
 :math:`P = \operatorname{diag}(\sigma_r^2, \sigma_\theta^2)`, transformée par
 :math:`f(r, \theta) = (r\cos\theta, r\sin\theta)`. Deux approximations de la loi de :math:`f(x)` :
 
-- **exacte** (Monte-Carlo) : moyenne et covariance empiriques de 3000 tirages (graine fixe ; les mêmes
-  tirages normaux sont mis à l'échelle de :math:`(\sigma_r, \sigma_\theta)`) ;
+- **exacte** : moyenne et covariance en forme close, :math:`\mathbb E[f(x)] = \hat r\,e^{-\sigma_\theta^2/2}
+  (\cos\hat\theta, \sin\hat\theta)` (:func:`~kalman_course.scenarios.banana.banana_truth`) ; le nuage
+  de Monte-Carlo (3000 tirages, graine fixe ; les mêmes tirages normaux mis à l'échelle de
+  :math:`(\sigma_r, \sigma_\theta)`) les illustre, ses moments empiriques en restent à l'erreur de
+  Monte-Carlo près ;
 - **EKF** : :math:`f(\hat x)` et :math:`J P J^T` (:func:`~kalman_course.ekf_predict`, bruit d'état nul).
 
-(La transformée sans parfum de la même loi est au chapitre de l'UKF, :mod:`.banana`.)
+(La transformée *unscented* de la même loi est au chapitre de l'UKF, :mod:`.banana`.)
 
 Avec :math:`\sigma_r = 0{,}5` m et :math:`\sigma_\theta = 20°`, c'est la figure de linéarisation du
 chapitre de l'EKF.
@@ -25,6 +28,7 @@ from ..core.models import NonlinearModel
 from ..core.results import freeze_fields
 from ..core.validation import KalmanInputError, as_float_array
 from ..filters.extended import ekf_predict
+from .banana import banana_truth
 
 __all__ = [
     "POLAR_MEAN",
@@ -66,7 +70,8 @@ def polar_to_cartesian_jacobian(x, u=None):
 @dataclass(frozen=True, eq=False)
 class PolarTransform:
     r"""``samples`` (N, 2) tirages polaires (m, rad) ; ``mapped`` (N, 2) leurs images (m) ;
-    ``exact_mean`` (2,), ``exact_cov`` (2, 2) : moments empiriques des images ; ``ekf_mean``, ``ekf_cov``."""
+    ``exact_mean`` (2,), ``exact_cov`` (2, 2) : moments exacts de :math:`f(x)` (forme close) ;
+    ``sample_mean``, ``sample_cov`` : moments empiriques des tirages ; ``ekf_mean``, ``ekf_cov``."""
 
     samples: np.ndarray
     mapped: np.ndarray
@@ -74,9 +79,12 @@ class PolarTransform:
     exact_cov: np.ndarray
     ekf_mean: np.ndarray
     ekf_cov: np.ndarray
+    sample_mean: np.ndarray
+    sample_cov: np.ndarray
 
     def __post_init__(self) -> None:
-        freeze_fields(self, "samples", "mapped", "exact_mean", "exact_cov", "ekf_mean", "ekf_cov")
+        freeze_fields(self, "samples", "mapped", "exact_mean", "exact_cov", "ekf_mean", "ekf_cov",
+                      "sample_mean", "sample_cov")
 
     @property
     def ekf_bias(self) -> float:
@@ -103,4 +111,6 @@ def polar_transform(range_std: float = POLAR_RANGE_STD, bearing_std_deg: float =
     rng = np.random.default_rng(seed)
     samples = POLAR_MEAN + rng.standard_normal((n_samples, 2)) * std
     mapped = np.array([polar_to_cartesian(s) for s in samples])
-    return PolarTransform(samples, mapped, mapped.mean(axis=0), np.cov(mapped.T), pred.x, pred.P)
+    exact = banana_truth(std[0], std[1], r=float(POLAR_MEAN[0]), bearing=float(POLAR_MEAN[1]))
+    return PolarTransform(samples, mapped, exact.mean, exact.cov, pred.x, pred.P,
+                          mapped.mean(axis=0), np.cov(mapped.T))

@@ -111,6 +111,35 @@ def _formatting_style():
             result = first_of[volume_and_series, number_and_series, optional_field("series")]
             return sentence(capfirst=True)[result] if as_sentence else result
 
+        def format_edition(self, e):
+            # « 4ᵉ édition », « 1ʳᵉ édition » (le style de base écrit « 4 edition »)
+            def ordinal(text):
+                plain = str(text)
+                return text + ("ʳᵉ" if plain == "1" else "ᵉ") if plain.isdigit() else text.lower()
+
+            return optional[words[field("edition", apply_func=ordinal), "édition"]]
+
+        def format_chapter_and_pages(self, e):
+            return join(sep=", ")[optional[together["chapitre", field("chapter")]], optional[together["pages", pages]]]
+
+        def get_incollection_template(self, e):
+            return toplevel[
+                sentence[self.format_names("author")],
+                self.format_title(e, "title"),
+                words[
+                    "Dans",
+                    sentence[
+                        optional[self.format_editor(e, as_sentence=False)],
+                        self.format_btitle(e, "booktitle", as_sentence=False),
+                        self.format_volume_and_series(e, as_sentence=False),
+                        self.format_chapter_and_pages(e),
+                    ],
+                ],
+                sentence[optional_field("publisher"), optional_field("address"), self.format_edition(e), date],
+                sentence[optional_field("note")],
+                self.format_web_refs(e),
+            ]
+
         def get_techreport_template(self, e):
             return toplevel[
                 sentence[self.format_names("author")],

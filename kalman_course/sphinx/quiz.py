@@ -28,7 +28,7 @@ l'explication. ``:name:`` donne un identifiant stable à la question (pour les t
   déplient l'explication. Aucun serveur, aucun noyau, aucune requête.
 - **Autres sorties** (LaTeX/PDF, texte) : les questions deviennent une liste numérotée, les réponses
   proposées des sous-listes (a), (b), (c)… et les bonnes réponses, avec leur explication, sont
-  regroupées dans une section « Réponses du quiz » à la fin du chapitre.
+  regroupées sous un intertitre « Réponses du quiz » à la fin du chapitre.
 """
 
 from __future__ import annotations
@@ -280,12 +280,14 @@ def _as_plain_nodes(app, doctree, questions: list[quiz_question]) -> None:
         node.replace_self([rubric, listing])
     if not answers:
         return
-    section = nodes.section(ids=["kc-quiz-reponses"], names=["réponses du quiz"])
-    section += nodes.title(text="Réponses du quiz")
-    for block in answers:
-        section.extend(block)
+    # un intertitre (rubrique), pas une section : ni numéro ni entrée dans la table des matières, et la
+    # page d'accueil, dont LaTeX aplatit les sections, n'en fait pas une « partie » avant le cours
+    heading = nodes.rubric(text="Réponses du quiz", ids=["kc-quiz-reponses"])
     top = next(iter(doctree.findall(nodes.section)), None)
-    (top if top is not None else doctree).append(section)
+    target = top if top is not None else doctree
+    target.append(heading)
+    for block in answers:
+        target.extend(block)
 
 
 def _resolve(app, doctree, docname: str) -> None:

@@ -1,8 +1,13 @@
 r"""Typographie française du livre, appliquée une fois pour toutes à la construction (extension Sphinx).
 
-Les règles (espaces insécables avant « : ; ! ? % » et dans « », apostrophe « ’ ») sont celles de
-:mod:`kalman_course.typography` ; cette extension les applique au texte courant de chaque page, jamais
-dans le code, les formules ou le HTML brut.
+Règles, sur le texte courant seulement (jamais dans le code, les formules, le HTML brut) :
+
+- celles de :mod:`kalman_course.typography` : espace insécable (U+00A0) avant « : » et à l'intérieur
+  des guillemets « », espace fine insécable (U+202F) avant « ; », « ! », « ? » et « % », une seule
+  apostrophe, la typographique « ’ » (U+2019) ;
+- un renvoi à un chapitre (``{doc}`` sans texte) cite son titre entre guillemets : « … » ;
+- les locutions latines *a priori* et *a posteriori* en italique (:func:`italicize_latin`) ;
+- les mêmes règles dans les étiquettes des diagrammes Mermaid (:func:`typeset_mermaid`).
 
 À déclarer dans ``_config.yml`` (``sphinx: extra_extensions``), avec ``smartquotes: false`` : les
 « guillemets intelligents » de docutils devinent mal l'apostrophe placée devant un mot en gras ou un
@@ -11,9 +16,11 @@ lien (« l” » au lieu de « l’ ») ; ce module la traite à leur place, san
 
 from __future__ import annotations
 
-from ..typography import apply_rules, french_spacing
+import re
 
-__all__ = ["typeset", "setup"]
+from ..typography import NBSP, apply_rules, french_spacing
+
+__all__ = ["typeset", "italicize_latin", "quote_document_titles", "typeset_mermaid", "setup"]
 
 
 # --------------------------------------------------------------------------- extension Sphinx
@@ -66,9 +73,101 @@ def typeset(document) -> int:
     return changed
 
 
+#: Texte d'une étiquette de diagramme Mermaid : entre guillemets droits (``A["…"]``, ``-->|"…"|``).
+_MERMAID_LABEL = re.compile(r'"([^"\n]*)"')
+
+
+def typeset_mermaid(document) -> int:
+    """Applique les règles aux étiquettes des diagrammes Mermaid (le code du diagramme est un attribut
+    du nœud, que :func:`typeset` ne voit pas) ; seul le texte entre guillemets change, jamais la syntaxe
+    (« style A fill:#fff ») ; *a priori* et *a posteriori* y passent en italique (``<i>``). Renvoie le
+    nombre de diagrammes modifiés."""
+    changed = 0
+    for node in document.findall(lambda n: getattr(n, "tagname", "") == "mermaid" and "code" in n.attributes):
+        old = node["code"]
+        new = _MERMAID_LABEL.sub(lambda m: '"' + _LATIN_HTML.sub(r"<i>\1</i>", apply_rules(m.group(1))) + '"', old)
+        if new != old:
+            node["code"] = new
+            changed += 1
+    return changed
+
+
+#: Locutions latines composées en italique dans le texte courant.
+_LATIN = re.compile(r"(?<![\w-])(a (?:priori|posteriori))(?![\w-])")
+#: La même, dans une étiquette HTML (Mermaid) : pas déjà entre ``<i>`` et ``</i>``.
+_LATIN_HTML = re.compile(r"(?<![\w-])(?<!<i>)(a (?:priori|posteriori))(?![\w-])")
+
+
+def italicize_latin(document) -> int:
+    """Met en italique les locutions latines (*a priori*, *a posteriori*) du texte courant de
+    ``document`` : pas dans le code, les formules, le HTML brut, ni dans un texte déjà en italique.
+    Renvoie le nombre de locutions mises en italique."""
+    from docutils import nodes
+
+    skipped = _skipped_classes() + (nodes.emphasis,)
+    changed = 0
+    for node in list(document.findall(nodes.Text)):
+        parent = node.parent
+        if parent is None or not _LATIN.search(str(node)):
+            continue
+        ancestor, skip = parent, False
+        while ancestor is not None:
+            if isinstance(ancestor, skipped):
+                skip = True
+                break
+            ancestor = ancestor.parent
+        if skip:
+            continue
+        pieces = []
+        for i, part in enumerate(_LATIN.split(str(node))):
+            if i % 2:
+                pieces.append(nodes.emphasis(part, part))
+                changed += 1
+            elif part:
+                pieces.append(nodes.Text(part))
+        index = parent.index(node)
+        parent.remove(node)
+        for offset, piece in enumerate(pieces):
+            parent.insert(index + offset, piece)
+    return changed
+
+
+def quote_document_titles(document, env) -> int:
+    """Les renvois ``{doc}`` sans texte explicite citent le titre du chapitre entre guillemets français :
+    « le chapitre « Lissage… » », jamais « le Le filtre… » (un titre cité se met entre guillemets, et
+    l'article de la phrase ne bute plus sur celui du titre). Renvoie le nombre de renvois modifiés."""
+    from docutils import nodes
+    from sphinx import addnodes
+    from sphinx.util import docname_join
+    from sphinx.util.nodes import clean_astext
+
+    changed = 0
+    for ref in list(document.findall(addnodes.pending_xref)):
+        if ref.get("refdomain") != "std" or ref.get("reftype") != "doc" or ref.get("refexplicit"):
+            continue
+        docname = docname_join(ref.get("refdoc", env.docname), ref["reftarget"])
+        if docname not in env.titles:
+            continue  # renvoi cassé : Sphinx le signale lui-même
+        quoted = "«" + NBSP + clean_astext(env.titles[docname]) + NBSP + "»"
+        inner = nodes.inline(quoted, quoted, classes=["xref", "std", "std-doc"])
+        ref.children = []
+        ref += inner
+        ref["refexplicit"] = True
+        changed += 1
+    return changed
+
+
 def _transforms():
     from sphinx.transforms import SphinxTransform
     from sphinx.transforms.post_transforms import SphinxPostTransform
+
+    class QuotedDocumentTitles(SphinxPostTransform):
+        """Avant la résolution des renvois (priorité 10) : titres de chapitres cités entre « »."""
+
+        default_priority = 5
+
+        def run(self, **kwargs) -> None:
+            quote_document_titles(self.document, self.env)
 
     class FrenchTypography(SphinxTransform):
         """À la lecture : les titres (table des matières, liens « suivant ») en profitent aussi."""
@@ -76,7 +175,9 @@ def _transforms():
         default_priority = 760  # après les transformations de docutils et de Sphinx sur le texte
 
         def apply(self, **kwargs) -> None:
+            italicize_latin(self.document)
             typeset(self.document)
+            typeset_mermaid(self.document)
 
     class FrenchTypographyLate(SphinxPostTransform):
         """À l'écriture : texte résolu après la lecture (références, nombres collés d'autres pages)."""
@@ -84,9 +185,10 @@ def _transforms():
         default_priority = 900
 
         def run(self, **kwargs) -> None:
+            italicize_latin(self.document)  # textes résolus : titres cités par {ref}, nombres collés…
             typeset(self.document)
 
-    return FrenchTypography, FrenchTypographyLate
+    return FrenchTypography, FrenchTypographyLate, QuotedDocumentTitles
 
 
 def _check_smartquotes(app, config) -> None:
@@ -100,8 +202,9 @@ def _check_smartquotes(app, config) -> None:
 
 
 def setup(app):
-    early, late = _transforms()
+    early, late, quoted = _transforms()
     app.add_transform(early)
     app.add_post_transform(late)
+    app.add_post_transform(quoted)
     app.connect("config-inited", _check_smartquotes)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
