@@ -9,7 +9,6 @@ import pytest
 import scipy.stats
 
 import kalman_course as kc
-from kalman_course.filters.gating import gate_threshold
 from kalman_course.scenarios import helicopter as heli
 from kalman_course.scenarios import manoeuvre as man
 

@@ -182,7 +182,7 @@ def gate_figure():
     ax.plot(track.y[:, 0] / 1e3, track.y[:, 1] / 1e3, "+", color=MEASURED, ms=4, label="positions mesurées")
     ax.plot(clean.x[:, 0] / 1e3, clean.x[:, 1] / 1e3, color=FUSED, lw=1.0, label=f"q appris ({fr(q, '.1f')} m²/s³)")
     ax.plot(quiet.x[:, 0] / 1e3, quiet.x[:, 1] / 1e3, color="crimson", lw=1.4,
-            label=f"q / 100, porte p = 0,999")
+            label=f"q / 100, porte p = {fr(0.999, '.3f')}")
     rej = np.asarray(quiet.rejected)
     ax.plot(track.y[rej, 0] / 1e3, track.y[rej, 1] / 1e3, "o", mfc="none", color="crimson", ms=4, alpha=0.6,
             label="positions rejetées")

@@ -47,9 +47,7 @@ from .gaussian import (
     correct_gaussian,
     gaussian_family,
     predict_gaussian_many,
-    measurement_noises,
     predict_gaussian,
-    process_noises,
     residuals,
 )
 from .kalman import Prediction, Update

@@ -66,7 +66,6 @@ from ..core.linalg import symmetrize
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult
 from ..core.validation import (
-    KalmanInputError,
     as_controls,
     as_gaussian,
     as_measurements,

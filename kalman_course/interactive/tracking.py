@@ -11,7 +11,6 @@ r"""Curseurs des chapitres de pistage.
 
 from __future__ import annotations
 
-from functools import lru_cache
 
 import numpy as np
 

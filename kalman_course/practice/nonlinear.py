@@ -68,7 +68,7 @@ def _ranges_jacobian(x, anchors=_ANCHORS):
 
 
 def _ekf_case(label, x, P, y, h, H, R) -> Case:
-    n, m = x.shape[0], R.shape[0]
+    n = x.shape[0]
     model = NonlinearModel(lambda z, u: z, h, np.eye(n), R, np.eye(n), H)
     ref = ekf_update(model, x, P, y)
     return Case(label, (x, P, y, point_function("h", h, n, "x_pred"), point_function("H", H, n, "x_pred"), R),

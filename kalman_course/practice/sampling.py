@@ -17,7 +17,7 @@ import scipy.stats
 
 from ..filters.particle import systematic_resample as package_systematic
 from ..filters.unscented import sigma_points as package_sigma_points
-from ..filters.unscented import sigma_weights, unscented_transform as package_ut
+from ..filters.unscented import unscented_transform as package_ut
 from .grading import Case, Exercise, Mistake, Output, close
 from .matrices import generator, spd
 from .nonlinear import point_function

@@ -27,7 +27,7 @@ import numpy as np
 from ..core.results import FilterResult
 from ..core.simulation import as_generator, check_positive_int
 from ..core.validation import KalmanInputError
-from ..diagnostics.consistency import chi2_band, nees
+from ..diagnostics.consistency import chi2_band
 from ..filters.cubature import CUBATURE, cubature_kalman_filter_runs
 from ..filters.ensemble import ensemble_kalman_filter
 from ..filters.extended import extended_kalman_filter_runs
