@@ -34,10 +34,10 @@ from .extended import (
     check_model,
     linearize_observation,
     linearize_observations,
-    measurement_noises,
     predict_moments,
     predict_moments_many,
 )
+from .gaussian import measurement_noises
 from .iteration import (
     DEFAULT_MAX_ITER,
     DEFAULT_TOL,
