@@ -26,7 +26,7 @@ from ..core.results import freeze_fields
 from ..core.simulation import as_generator, check_positive_int
 from ..core.validation import KalmanInputError
 from ..filters.unscented import unscented_transform
-from .polar import polar_to_cartesian, polar_to_cartesian_jacobian
+from .polar import polar_moments, polar_to_cartesian, polar_to_cartesian_jacobian
 
 __all__ = [
     "BANANA_RANGE",
@@ -87,14 +87,7 @@ def banana_truth(
 ) -> Moments:
     r"""Moyenne et covariance exactes de :math:`g(r, \theta)` (formes closes de l'en-tête)."""
     sr, st = _check_std("range_std", range_std), _check_std("bearing_std", bearing_std)
-    e1, e2 = np.exp(-0.5 * st**2), np.exp(-2.0 * st**2)
-    r2 = r**2 + sr**2
-    mean = r * e1 * np.array([np.cos(bearing), np.sin(bearing)])
-    cc = 0.5 * (1.0 + np.cos(2 * bearing) * e2)
-    ss = 0.5 * (1.0 - np.cos(2 * bearing) * e2)
-    sc = 0.5 * np.sin(2 * bearing) * e2
-    cov = r2 * np.array([[cc, sc], [sc, ss]]) - np.outer(mean, mean)
-    return Moments(mean, cov)
+    return Moments(*polar_moments(sr, st, r, bearing))
 
 
 def banana_linearized(

@@ -6,7 +6,7 @@ filtre de Kalman étendu »).
 :math:`f(r, \theta) = (r\cos\theta, r\sin\theta)`. Deux approximations de la loi de :math:`f(x)` :
 
 - **exacte** : moyenne et covariance en forme close, :math:`\mathbb E[f(x)] = \hat r\,e^{-\sigma_\theta^2/2}
-  (\cos\hat\theta, \sin\hat\theta)` (:func:`~kalman_course.scenarios.banana.banana_truth`) ; le nuage
+  (\cos\hat\theta, \sin\hat\theta)` (:func:`polar_moments`, que :func:`~kalman_course.scenarios.banana.banana_truth` reprend) ; le nuage
   de Monte-Carlo (3000 tirages, graine fixe ; les mêmes tirages normaux mis à l'échelle de
   :math:`(\sigma_r, \sigma_\theta)`) les illustre, ses moments empiriques en restent à l'erreur de
   Monte-Carlo près ;
@@ -28,7 +28,6 @@ from ..core.models import NonlinearModel
 from ..core.results import freeze_fields
 from ..core.validation import KalmanInputError, as_float_array
 from ..filters.extended import ekf_predict
-from .banana import banana_truth
 
 __all__ = [
     "POLAR_MEAN",
@@ -38,6 +37,7 @@ __all__ = [
     "POLAR_SEED",
     "polar_to_cartesian",
     "polar_to_cartesian_jacobian",
+    "polar_moments",
     "PolarTransform",
     "polar_transform",
 ]
@@ -65,6 +65,22 @@ def polar_to_cartesian_jacobian(x, u=None):
     r""":math:`J = \begin{bmatrix}\cos\theta & -r\sin\theta\\ \sin\theta & r\cos\theta\end{bmatrix}`."""
     c, s = np.cos(x[1]), np.sin(x[1])
     return np.array([[c, -x[0] * s], [s, x[0] * c]])
+
+
+def polar_moments(range_std: float, bearing_std: float, r: float, bearing: float) -> tuple[np.ndarray, np.ndarray]:
+    r"""Moyenne (2,) et covariance (2, 2) exactes de :math:`f(r, \theta)` pour :math:`r \sim \mathcal N(\bar r,
+    \sigma_r^2)` et :math:`\theta \sim \mathcal N(\bar\theta, \sigma_\theta^2)` indépendants (m, m²) :
+    :math:`\mathbb E[\cos\theta] = \cos\bar\theta\, e^{-\sigma_\theta^2/2}`,
+    :math:`\mathbb E[\cos^2\theta] = \tfrac12(1 + \cos 2\bar\theta\, e^{-2\sigma_\theta^2})`,
+    :math:`\mathbb E[\sin\theta\cos\theta] = \tfrac12\sin 2\bar\theta\, e^{-2\sigma_\theta^2}`,
+    :math:`\mathbb E[r^2] = \bar r^2 + \sigma_r^2` ; ``bearing_std`` en radians."""
+    e1, e2 = np.exp(-0.5 * bearing_std**2), np.exp(-2.0 * bearing_std**2)
+    mean = r * e1 * np.array([np.cos(bearing), np.sin(bearing)])
+    cc = 0.5 * (1.0 + np.cos(2 * bearing) * e2)
+    ss = 0.5 * (1.0 - np.cos(2 * bearing) * e2)
+    sc = 0.5 * np.sin(2 * bearing) * e2
+    cov = (r**2 + range_std**2) * np.array([[cc, sc], [sc, ss]]) - np.outer(mean, mean)
+    return mean, cov
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,6 +127,6 @@ def polar_transform(range_std: float = POLAR_RANGE_STD, bearing_std_deg: float =
     rng = np.random.default_rng(seed)
     samples = POLAR_MEAN + rng.standard_normal((n_samples, 2)) * std
     mapped = np.array([polar_to_cartesian(s) for s in samples])
-    exact = banana_truth(std[0], std[1], r=float(POLAR_MEAN[0]), bearing=float(POLAR_MEAN[1]))
-    return PolarTransform(samples, mapped, exact.mean, exact.cov, pred.x, pred.P,
+    exact_mean, exact_cov = polar_moments(std[0], std[1], float(POLAR_MEAN[0]), float(POLAR_MEAN[1]))
+    return PolarTransform(samples, mapped, exact_mean, exact_cov, pred.x, pred.P,
                           mapped.mean(axis=0), np.cov(mapped.T))
