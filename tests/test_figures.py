@@ -206,8 +206,8 @@ def _check_banana(fig):
 def _check_ukf_comparison(fig):
     comp = kc.scenarios.tag.tag_comparison()
     data = comp.data
-    ekf = line(fig, "EKF (erreur", ax=0)[:, 1] / 100
-    ukf = line(fig, "UKF (erreur", ax=0)[:, 1] / 100
+    ekf = line(fig, "EKF (REQM", ax=0)[:, 1] / 100
+    ukf = line(fig, "UKF (REQM", ax=0)[:, 1] / 100
     np.testing.assert_allclose(ekf, np.linalg.norm(comp.ekf.x[:, :2] - data.x_true[:, :2], axis=1), rtol=1e-12)
     np.testing.assert_allclose(ukf, np.linalg.norm(comp.ukf.x[:, :2] - data.x_true[:, :2], axis=1), rtol=1e-12)
     skip = kc.scenarios.tag.TAG_TRANSIENT_STEPS

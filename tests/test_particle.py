@@ -131,7 +131,7 @@ def test_mean_and_log_likelihood_match_the_exact_linear_gaussian_answer():
     np.testing.assert_allclose(np.array([r.P for r in runs]).mean(axis=0), ref.P, rtol=0.05, atol=1e-3)
     for r in runs:
         assert abs(r.log_likelihood - exact) < 0.3, (r.log_likelihood, exact)
-    assert exact == pytest.approx(convergence._kalman_log_likelihood(ref), abs=1e-8)
+    assert exact == pytest.approx(kc.filter_log_likelihood(ref), abs=1e-8)
 
 
 def test_error_decreases_as_one_over_root_n():

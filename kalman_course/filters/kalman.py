@@ -111,7 +111,7 @@ def _control_term(model: LinearGaussianModel, u: Any) -> np.ndarray | None:
 # --------------------------------------------------------------------------- étapes publiques
 
 
-def predict(model: LinearGaussianModel, x: Any, P: Any, u: Any = None) -> Prediction:
+def predict(model: LinearGaussianModel, x: Any, P: Any, u: Any = None, *, fading: Any = None) -> Prediction:
     r"""Étape de prédiction (*time update*).
 
     .. math::
@@ -119,9 +119,14 @@ def predict(model: LinearGaussianModel, x: Any, P: Any, u: Any = None) -> Predic
         \hat x_{k\mid k-1} = A\,\hat x_{k-1\mid k-1} + B\,u_{k-1},\qquad
         P_{k\mid k-1} = A\,P_{k-1\mid k-1}A^T + Q
 
-    Paramètres : ``x`` (n,), ``P`` (n, n) symétrique semi-définie positive, ``u`` (p,) ou ``None``.
+    Paramètres : ``x`` (n,), ``P`` (n, n) symétrique semi-définie positive, ``u`` (p,) ou ``None`` ;
+    ``fading`` : facteur :math:`\alpha \ge 1` de mémoire évanescente, :math:`P_{k\mid k-1} = \alpha^2AP
+    A^T + Q` (:mod:`~kalman_course.filters.gating`). Modèle variable dans le temps : passez ``model.at(k)``.
     """
+    alpha2 = fading_factor(fading)
     x_arr, P_arr = _check_state(x, P, model.n_state, "x", "P")
+    if alpha2 is not None:
+        P_arr = alpha2 * P_arr
     x_pred, P_pred = _predict(x_arr, P_arr, model.A, model.Q, _control_term(model, u))
     return Prediction(x_pred, P_pred)
 

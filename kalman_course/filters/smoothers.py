@@ -417,9 +417,15 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
     x_next = (x[:-1, None, :] @ At)[:, 0] if model.B is None else None
     _check_consistency(result, symmetrize(A @ P[:-1] @ At + Q), x_next, C, R,
                        "filtre de Kalman", " (rts_smoother lisse la sortie de kalman_filter)")
-    try:  # en racine carrée : sûr pour un a priori vague
-        xs, Ps, G, lag = square_root_rts_pass(x, P, result.x_pred, A, model.noise_roots[0])
-    except KalmanInputError:  # P⁻ singulière : gains de moindres carrés (smoother_gains), forme usuelle
+    sqrt_pass = None
+    if not model.time_varying:  # en racine carrée : sûr pour un a priori vague (modèle constant)
+        try:
+            sqrt_pass = square_root_rts_pass(x, P, result.x_pred, A, model.noise_roots[0])
+        except KalmanInputError:  # P⁻ singulière : gains de moindres carrés, forme usuelle ci-dessous
+            pass
+    if sqrt_pass is not None:
+        xs, Ps, G, lag = sqrt_pass
+    else:  # modèle variable dans le temps, ou P⁻ singulière : gains de smoother_gains, forme usuelle
         G = np.zeros_like(P)
         if result.n_steps > 1:
             G[:-1] = smoother_gains(P[:-1], result.P_pred[1:], A)
