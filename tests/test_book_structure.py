@@ -28,6 +28,12 @@ def _toc() -> list[str]:
 
 TOC = _toc()
 CHAPTERS = [p for p in TOC if p not in APPENDICES and p != TOC[0]]
+#: Travaux dirigés et travaux pratiques : des pages d'exercices, pas des chapitres. Elles gardent en tête
+#: les encadrés « Objectifs » et « Prérequis » (les chapitres à avoir lus) et finissent par un quiz ; elles
+#: n'ont ni section « À retenir » (un encadré la remplace, après le quiz), ni « La suite », ni bibliographie :
+#: le cours qu'elles exercent est dans les chapitres cités en prérequis.
+PRACTICE = [p for p in CHAPTERS if re.match(r"t[dp]-", p)]
+LESSONS = [p for p in CHAPTERS if p not in PRACTICE]
 
 
 def _text(page: str) -> str:
@@ -35,10 +41,35 @@ def _text(page: str) -> str:
 
 
 def _prose(text: str) -> str:
-    """Le texte sans les cellules de code, les blocs de code et les formules en display."""
-    text = re.sub(r"```\{code-cell\}.*?```", "", text, flags=re.S)
-    text = re.sub(r"```(?:python|bash|text)?\n.*?```", "", text, flags=re.S)
-    return re.sub(r"\$\$.*?\$\$", "", text, flags=re.S)
+    """Le texte sans les cellules de code, les blocs de code et les formules en display. Les directives
+    à trois accents graves (```{exercise}, ```{dropdown}…) restent : leur contenu est de la prose. On lit
+    ligne à ligne, pour qu'une clôture « ``` » ne soit jamais prise pour l'ouverture d'un bloc de code."""
+    kept, stack = [], []
+    for line in text.splitlines(keepends=True):
+        fence = line.rstrip("\n")
+        if stack and stack[-1] == "code":
+            if fence == "```":
+                stack.pop()
+            continue
+        if fence == "```" and stack:
+            stack.pop()
+        elif fence.startswith("```") and not fence.startswith("````"):
+            directive = fence[3:].startswith("{") and not fence[3:].startswith("{code-cell}")
+            stack.append("directive" if directive else "code")
+            if not directive:
+                continue
+        kept.append(line)
+    return re.sub(r"\$\$.*?\$\$", "", "".join(kept), flags=re.S)
+
+
+def test_prose_drops_code_but_keeps_directives_and_the_prose_after_a_block():
+    text = ("Avant.\n\n```{code-cell} ipython3\nx = 1  # code\n```\n\nEntre.\n\n```{exercise}\n:label: e\n"
+            "Énoncé.\n```\n\nAprès.\n\n```python\nimport kalman_course\n```\n\nFin.\n\n$$\nx^2\n$$\n")
+    prose = _prose(text)
+    for kept in ("Avant.", "Entre.", "Énoncé.", "Après.", "Fin."):
+        assert kept in prose, kept
+    for dropped in ("# code", "import kalman_course", "x^2"):
+        assert dropped not in prose, dropped
 
 
 def _title(page: str) -> str:
@@ -97,11 +128,58 @@ def test_furniture_check_flags_missing_boxes_sections_and_bridges():
     assert len(furniture_problems(no_bib, {"suite"})) == 2
 
 
-@pytest.mark.parametrize("chapter", CHAPTERS)
+@pytest.mark.parametrize("chapter", LESSONS)
 def test_every_chapter_has_the_same_furniture(chapter):
     later = set(TOC[TOC.index(chapter) + 1:])
     problems = furniture_problems(_text(chapter), later)
     assert not problems, f"{chapter} : " + " ; ".join(problems)
+
+
+def practice_furniture_problems(text: str) -> list[str]:
+    """Le mobilier d'une page de TD ou de TP : encadrés « Objectifs » puis « Prérequis » avant la première
+    section, et une section « Quiz » qui porte un quiz. Ni « À retenir » en section, ni « La suite », ni
+    bibliographie ne sont exigés."""
+    problems = []
+    head = text.split("\n## ", 1)[0]
+    if not re.search(r"^:::\{admonition\} Objectifs\n:class: note\n", head, re.M):
+        problems.append("pas d'encadré « Objectifs » en tête")
+    prerequisites = re.search(r"^:::\{admonition\} Prérequis\n:class: note\n(.*?)^:::$", head, re.M | re.S)
+    if not prerequisites:
+        problems.append("pas d'encadré « Prérequis » séparé en tête")
+    elif not re.search(r"\{doc\}`", prerequisites.group(1)):
+        problems.append("l'encadré « Prérequis » ne renvoie à aucun chapitre")
+    if re.search(r"^\*\*Prérequis\*\*", text, re.M):
+        problems.append("« Prérequis » dans le texte au lieu d'un encadré")
+    quiz = text.split("\n## Quiz\n", 1)[1].split("\n## ", 1)[0] if "\n## Quiz\n" in text else ""
+    if not re.search(r"^::::\{quiz\}", quiz, re.M):
+        problems.append("pas de section « Quiz » avec son quiz")
+    return problems
+
+
+def test_practice_furniture_check_flags_missing_boxes_and_quiz():
+    good = (":::{admonition} Objectifs\n:class: note\n- a\n- b\n:::\n\n:::{admonition} Prérequis\n:class: note\n"
+            "Le chapitre {doc}`ukf`.\n:::\n\nTexte.\n\n## 1. Un exercice\n\nTexte.\n\n## Quiz\n\n"
+            "::::{quiz}\n:::{question}\nQ ?\n- a\n- b\n:::\n::::\n\n:::{admonition} À retenir\n:class: tip\n- a\n:::\n")
+    assert practice_furniture_problems(good) == []
+    inside = good.replace(":::\n\n:::{admonition} Prérequis\n:class: note\nLe", "\n**Prérequis** : le")
+    assert len(practice_furniture_problems(inside)) == 2
+    assert practice_furniture_problems(good.replace("{doc}`ukf`", "précédent")) == [
+        "l'encadré « Prérequis » ne renvoie à aucun chapitre"]
+    assert practice_furniture_problems(good.replace("## Quiz", "## Questions")) == [
+        "pas de section « Quiz » avec son quiz"]
+    assert practice_furniture_problems(good.replace(":::{admonition} Objectifs", ":::{admonition} Buts")) == [
+        "pas d'encadré « Objectifs » en tête"]
+
+
+def test_practice_pages_are_the_td_and_tp_pages():
+    assert PRACTICE and all(p.startswith(("td-", "tp-")) for p in PRACTICE)
+    assert len(LESSONS) >= 20 and not any(p.startswith(("td-", "tp-")) for p in LESSONS)
+
+
+@pytest.mark.parametrize("page", PRACTICE)
+def test_every_practice_page_has_its_furniture(page):
+    problems = practice_furniture_problems(_text(page))
+    assert not problems, f"{page} : " + " ; ".join(problems)
 
 
 #: Les chapitres et les algorithmes que leur encadré ``prf:algorithm`` doit porter.
@@ -197,7 +275,7 @@ def test_wording_of_the_course(page):
     assert not problems, f"{page} : " + " ; ".join(problems)
 
 
-_SOFTWARE = re.compile(r"\b[Ll]es tests (?:du paquet )?(?:vérifient|comparent)|`test_\w+`")
+_SOFTWARE = re.compile(r"\b[Ll]es tests (?:du paquet )?(?:l[ea] |les |l['’])?(?:vérifient|comparent)|`test_\w+`")
 
 
 def software_talk_outside_boxes(text: str) -> list[str]:
@@ -209,6 +287,8 @@ def software_talk_outside_boxes(text: str) -> list[str]:
 def test_software_talk_check():
     assert software_talk_outside_boxes("La covariance est juste (test `test_joseph`). Les tests vérifient tout.") \
         == ["`test_joseph`", "Les tests vérifient"]
+    assert software_talk_outside_boxes("C'est le même calcul. Les tests du paquet le vérifient.") == [
+        "Les tests du paquet le vérifient"]
     boxed = ":::{admonition} Dans le paquet\n:class: seealso\nLe test `test_joseph` la compare.\n:::\n"
     assert software_talk_outside_boxes("La covariance est juste.\n\n" + boxed) == []
 

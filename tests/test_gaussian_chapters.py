@@ -21,10 +21,10 @@ from kalman_course.scenarios.convergence import loglog_slope
 
 def test_banana_mean_error_slopes_are_the_orders_of_the_rules():
     """Pente log-log de l'erreur de la moyenne : degré d'exactitude + 1 (2 linéarisation, 4 cubature,
-    6 sans parfum avec n + κ = 3 et Gauss–Hermite p = 3, 10 pour p = 5) — les nombres que cite le chapitre."""
+    6 unscented avec n + κ = 3 et Gauss–Hermite p = 3, 10 pour p = 5) — les nombres que cite le chapitre."""
     stds = np.array([0.1, 0.2, 0.4])
     errors = gaussian_rules.banana_mean_errors(stds, orders=(3, 5))
-    expected = {"linéarisation (EKF)": 2, "cubature (CKF)": 4, "sans parfum (UKF)": 6,
+    expected = {"linéarisation (EKF)": 2, "cubature (CKF)": 4, "unscented (UKF)": 6,
                 "Gauss–Hermite, p = 3 (GHKF)": 6, "Gauss–Hermite, p = 5 (GHKF)": 10}
     for name, slope in expected.items():
         assert loglog_slope(stds, errors[name]) == pytest.approx(slope, abs=0.1), name
@@ -58,7 +58,7 @@ def test_cube_variance_errors_by_rule():
 
 def test_points_per_step():
     counts = gaussian_rules.points_per_step((1, 4, 10))
-    np.testing.assert_array_equal(counts["sans parfum (UKF) : 2n + 1"], [3, 9, 21])
+    np.testing.assert_array_equal(counts["unscented (UKF) : 2n + 1"], [3, 9, 21])
     np.testing.assert_array_equal(counts["cubature (CKF) : 2n"], [2, 8, 20])
     np.testing.assert_array_equal(counts["Gauss–Hermite, p = 3 : 3ⁿ"], [3, 81, 59049])
     assert kc.GaussHermiteRule(3).n_points(4) == 81 and kc.CubatureRule().n_points(4) == 8

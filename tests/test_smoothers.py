@@ -400,12 +400,12 @@ def test_target_scenario_claims():
     assert sd_s[-1] == sd_f[-1]
 
 
-# --------------------------------------------------------------------------- lisseur RTS sans parfum
+# --------------------------------------------------------------------------- lisseur RTS unscented
 
 
 @pytest.mark.parametrize("alpha, beta, kappa", [(0.1, 2.0, -1.0), (1.0, 2.0, 0.0), (0.5, 0.0, 3.0)])
 def test_unscented_smoother_equals_filterpy_rts_smoother(alpha, beta, kappa):
-    """Tag UWB : le lisseur sans parfum du paquet contre ``UnscentedKalmanFilter.rts_smoother`` de filterpy,
+    """Tag UWB : le lisseur unscented du paquet contre ``UnscentedKalmanFilter.rts_smoother`` de filterpy,
     appliqué aux mêmes estimations filtrées."""
     from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 
@@ -442,10 +442,10 @@ def test_unscented_smoother_refuses_other_parameters_or_filters():
     model = kc.scenarios.pendulum.pendulum_model()
     res = kc.unscented_kalman_filter(model, data.y, data.x0, data.P0, alpha=0.5, kappa=0.0)
     kc.unscented_rts_smoother(model, res, alpha=0.5, kappa=0.0)  # accepté
-    with pytest.raises(kc.KalmanInputError, match="ne vient pas du filtre de Kalman sans parfum"):
+    with pytest.raises(kc.KalmanInputError, match="ne vient pas du filtre de Kalman unscented"):
         kc.unscented_rts_smoother(model, res, alpha=0.1, kappa=-1.0)
     ekf = kc.extended_kalman_filter(model, data.y, data.x0, data.P0)
-    with pytest.raises(kc.KalmanInputError, match="ne vient pas du filtre de Kalman sans parfum"):
+    with pytest.raises(kc.KalmanInputError, match="ne vient pas du filtre de Kalman unscented"):
         kc.unscented_rts_smoother(model, ekf, alpha=0.5, kappa=0.0)
 
 

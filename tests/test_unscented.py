@@ -115,7 +115,7 @@ def test_banana_closed_form_against_monte_carlo_and_the_three_answers():
 
 
 def test_mean_error_orders_two_four_six():
-    """Erreur de la moyenne : O(σ²) linéarisée, O(σ⁴) sans parfum (κ = 0), O(σ⁶) avec κ = 3 − n."""
+    """Erreur de la moyenne : O(σ²) linéarisée, O(σ⁴) unscented (κ = 0), O(σ⁶) avec κ = 3 − n."""
     stds = np.array([0.025, 0.05, 0.1])
     errors = banana.mean_error_orders(stds)
     slopes = [kc.scenarios.convergence.loglog_slope(stds, e) for e in errors]

@@ -18,7 +18,7 @@ CHAPTER = "filtre-gaussien"
 COLORS = {
     "vérité": "black",
     "linéarisation (EKF)": "tab:red",
-    "sans parfum (UKF)": "tab:blue",
+    "unscented (UKF)": "tab:blue",
     "cubature (CKF)": "tab:green",
     "Gauss–Hermite": "tab:purple",
     "Gauss–Hermite, p = 5": "tab:brown",
@@ -38,7 +38,7 @@ def _color(name: str) -> str:
           title="Les points de quatre règles d'intégration pour une même loi gaussienne (aire ∝ poids)")
 def gaussian_points():
     panels = (
-        ("sans parfum (α = 1, κ = 1) : 2n + 1 = 5 points", UnscentedRule(1.0, 2.0, 1.0), COLORS["sans parfum (UKF)"]),
+        ("unscented (α = 1, κ = 1) : 2n + 1 = 5 points", UnscentedRule(1.0, 2.0, 1.0), COLORS["unscented (UKF)"]),
         ("cubature : 2n = 4 points", CUBATURE, COLORS["cubature (CKF)"]),
         ("Gauss–Hermite p = 3 : 3² = 9 points", GaussHermiteRule(3), COLORS["Gauss–Hermite"]),
         ("Gauss–Hermite p = 5 : 5² = 25 points", GaussHermiteRule(5), COLORS["Gauss–Hermite, p = 5"]),
@@ -85,11 +85,11 @@ def gaussian_banana():
                   f"σᵣ = {format_number(100 * banana.BANANA_RANGE_STD, decimals=0)} cm : ellipses à 2σ", fontsize=10)
     ax0.grid(alpha=0.3)
     ax0.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7)
-    slopes = {"linéarisation (EKF)": 2, "sans parfum (UKF)": 6, "cubature (CKF)": 4,
+    slopes = {"linéarisation (EKF)": 2, "unscented (UKF)": 6, "cubature (CKF)": 4,
               "Gauss–Hermite, p = 3 (GHKF)": 6, "Gauss–Hermite, p = 5 (GHKF)": 10}
     for name, err in errors.items():
         color = COLORS["Gauss–Hermite, p = 5"] if "p = 5" in name else _color(name)
-        ls = ":" if name.startswith("sans parfum") else "-"
+        ls = ":" if name.startswith("unscented") else "-"
         ax1.loglog(np.rad2deg(stds), 1000 * err, "o" + ls, ms=3, color=color,
                    label=f"{name.replace(' (GHKF)', '')} : pente {slopes[name]}")
     ax1.set_xlabel("écart-type de l'azimut σθ (°)")
@@ -106,7 +106,7 @@ def gaussian_cost():
     ns = np.arange(1, 11)
     counts = gaussian_rules.points_per_step(ns)
     fig, ax = new_figure(width=7.0, height=3.8)
-    colors = [COLORS["sans parfum (UKF)"], COLORS["cubature (CKF)"], COLORS["Gauss–Hermite"],
+    colors = [COLORS["unscented (UKF)"], COLORS["cubature (CKF)"], COLORS["Gauss–Hermite"],
               COLORS["Gauss–Hermite, p = 5"]]
     for (name, values), color in zip(counts.items(), colors):
         ax.semilogy(ns, values, "o-", ms=4, color=color, label=name)

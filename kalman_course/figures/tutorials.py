@@ -59,7 +59,7 @@ def square_transform_figure():
         ax.vlines(p, 0.0, img, color="tab:orange", lw=0.8, ls=":")
         ax.annotate(f"poids {'2/3' if w > 0.5 else '1/6'}", (p, img), textcoords="offset points", xytext=(6, 6),
                     fontsize=8)
-    ax.axhline(s.mean, color="tab:blue", lw=1.5, label="moyenne sans parfum (= 1, exacte)")
+    ax.axhline(s.mean, color="tab:blue", lw=1.5, label="moyenne unscented (= 1, exacte)")
     ax.axhline(s.linearised_mean, color="tab:red", lw=1.5, ls="--", label="moyenne linéarisée f(0) = 0")
     ax.set_xlabel("x (sans unité)")
     ax.set_ylabel("f(x) = x² (sans unité)")

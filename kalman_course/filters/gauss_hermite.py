@@ -13,7 +13,7 @@ donne :math:`p^n` points :math:`\xi_{j_1\dots j_n} = (\xi_{j_1}, \dots, \xi_{j_n
 :math:`w_{j_1}\cdots w_{j_n}`, puis :math:`\chi = \hat x + L\xi` (:math:`LL^T = P`, Cholesky). Tous les poids
 sont positifs ; le coût, :math:`p^n` évaluations de :math:`f` et de :math:`h` par pas, croît
 exponentiellement avec la dimension (:math:`3^4 = 81`, :math:`3^{10} = 59\,049`) : c'est pourquoi les règles
-de cubature (:math:`2n` points) et sans parfum (:math:`2n + 1`) existent.
+de cubature (:math:`2n` points) et unscented (:math:`2n + 1`) existent.
 
 C'est le filtre gaussien (:mod:`kalman_course.filters.gaussian`) avec :class:`GaussHermiteRule`. Sur un
 modèle linéaire, il redonne le filtre de Kalman dès l'ordre 2.

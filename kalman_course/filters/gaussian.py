@@ -34,7 +34,7 @@ Les règles (une :class:`GaussianRule` chacune) :
       \Sigma = \sum_i W^c_i (g(\chi_i) - \mu)(g(\chi_i) - \mu)^T,\quad
       C = \sum_i W^c_i (\chi_i - \hat x)(g(\chi_i) - \mu)^T ;
 
-  transformée sans parfum (UKF, :mod:`~kalman_course.filters.unscented`), cubature sphérique–radiale
+  transformée unscented (UKF, :mod:`~kalman_course.filters.unscented`), cubature sphérique–radiale
   (CKF, :mod:`~kalman_course.filters.cubature`), Gauss–Hermite en produit tensoriel (GHKF,
   :mod:`~kalman_course.filters.gauss_hermite`).
 

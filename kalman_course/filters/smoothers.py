@@ -551,7 +551,7 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
 
 def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha: float | None = None,
                            beta: float = 2.0, kappa: float | None = None, u: Any = None) -> SmootherResult:
-    r"""Lisseur RTS « sans parfum » (Särkkä, 2008) pour un résultat de
+    r"""Lisseur RTS « unscented » (Särkkä, 2008) pour un résultat de
     :func:`~kalman_course.unscented_kalman_filter`, avec les mêmes paramètres :math:`(\alpha, \beta, \kappa)`.
 
     Pour :math:`k = T-2, \dots, 0` : points sigma :math:`\chi_i` de :math:`(\hat x_{k\mid k}, P_{k\mid k})`,
@@ -595,8 +595,8 @@ def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha
         xb[k], Pb[k], mom = predict_gaussian(rule, model, x[k], P[k], None if U is None else U[k + 1],
                                              f"lissage du pas {k}")
         G[k] = np.linalg.solve(Pb[k], mom.cross.T).T  # G = C P̄⁻¹, P̄ symétrique
-    _check_consistency(result, Pb, xb, None, None, "filtre de Kalman sans parfum",
+    _check_consistency(result, Pb, xb, None, None, "filtre de Kalman unscented",
                        ", les mêmes paramètres (alpha, beta, kappa) et les mêmes commandes « u » "
                        "(unscented_rts_smoother lisse la sortie d'unscented_kalman_filter)")
     xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
-    return SmootherResult(xs, Ps, G, lag, method="RTS sans parfum")
+    return SmootherResult(xs, Ps, G, lag, method="RTS unscented")

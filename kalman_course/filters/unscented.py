@@ -1,4 +1,4 @@
-r"""Filtre de Kalman sans parfum (*unscented Kalman filter*, UKF) : points sigma, transformée sans parfum,
+r"""Filtre de Kalman unscented (*unscented Kalman filter*, UKF) : points sigma, transformée unscented,
 étapes pures et famille pour le moteur.
 
 Points sigma de van der Merwe (Wan & van der Merwe, 2000), pour un état de dimension :math:`n`, de
@@ -175,7 +175,7 @@ def unscented_transform(
     vectorized: bool = False,
     angle_indices: tuple[int, ...] = (),
 ) -> UnscentedTransform:
-    r"""Transformée sans parfum de la loi :math:`(\bar x, P)` par la fonction ``fn`` :
+    r"""Transformée unscented de la loi :math:`(\bar x, P)` par la fonction ``fn`` :
 
     .. math::
 
@@ -217,7 +217,7 @@ def unscented_transform(
 
 @dataclass(frozen=True)
 class UnscentedRule(SymmetricSigmaRule):
-    r"""La **transformée sans parfum** comme règle du filtre gaussien (l'UKF) : les :math:`2n + 1` points
+    r"""La **transformée unscented** comme règle du filtre gaussien (l'UKF) : les :math:`2n + 1` points
     sigma de van der Merwe, :math:`c = n + \lambda = \alpha^2(n + \kappa)`, et leurs poids (voir
     l'en-tête du module). Exacte pour :math:`g` affine ; avec :math:`\alpha = 1, \beta = 0, \kappa = 0`,
     :math:`W_0 = 0` et c'est la règle de cubature (:class:`~kalman_course.filters.cubature.CubatureRule`)."""
@@ -227,7 +227,7 @@ class UnscentedRule(SymmetricSigmaRule):
     kappa: float = 0.0
 
     label = "UKF"
-    filter_name = "filtre de Kalman sans parfum (UKF)"
+    filter_name = "filtre de Kalman unscented (UKF)"
     point_name = "sigma"
 
     def check(self, model: NonlinearModel) -> None:
@@ -267,7 +267,7 @@ def unscented_kalman_filter(
     beta: float = 2.0,
     kappa: float | None = None,
 ) -> FilterResult:
-    r"""Filtre de Kalman sans parfum sur toutes les mesures (pour chaque ``y[k]`` : prédiction puis
+    r"""Filtre de Kalman unscented sur toutes les mesures (pour chaque ``y[k]`` : prédiction puis
     correction, dans l'ordre de :func:`~kalman_course.kalman_filter`).
 
     Paramètres
@@ -301,7 +301,7 @@ def unscented_kalman_filter_runs(
     beta: float = 2.0,
     kappa: float | None = None,
 ) -> FilterRuns:
-    r"""Filtre de Kalman sans parfum sur ``N`` tirages indépendants du même modèle, tous à la fois
+    r"""Filtre de Kalman unscented sur ``N`` tirages indépendants du même modèle, tous à la fois
     (:func:`~kalman_course.filters.engine.run_filter_runs`) : les formules de :func:`unscented_kalman_filter`
     appliquées à la pile des tirages ; les :math:`N(2n+1)` points sigma d'un pas passent par :math:`f` (ou
     :math:`h`) en un appel si le modèle est vectorisé.

@@ -1,4 +1,4 @@
-r"""Exercices des filtres à points : points sigma, transformée sans parfum, rééchantillonnage systématique,
+r"""Exercices des filtres à points : points sigma, transformée unscented, rééchantillonnage systématique,
 poids des particules en logarithme.
 
 Références : les poids de :func:`kalman_course.sigma_weights` et la transformée
@@ -189,7 +189,7 @@ def _detect_lambda_without_n(outs, case):
 
 SIGMA_POINTS = Exercise(
     id="sigma-points",
-    title="Points sigma et poids de la transformée sans parfum",
+    title="Points sigma et poids de la transformée unscented",
     chapter="ukf",
     signature="sigma_points(x, P, alpha, beta, kappa) -> (chi, wm, wc)",
     parameters=("x", "P", "alpha", "beta", "kappa"),
@@ -225,7 +225,7 @@ SIGMA_POINTS = Exercise(
 )
 
 
-# --------------------------------------------------------------------------- transformée sans parfum
+# --------------------------------------------------------------------------- transformée unscented
 
 
 def _ut_case(label, x, P, func, alpha, beta, kappa) -> Case:
@@ -307,7 +307,7 @@ def _f_on_all_points(exc: BaseException, line: str) -> bool:
 
 UNSCENTED_TRANSFORM = Exercise(
     id="unscented-transform",
-    title="Transformée sans parfum : moyenne et covariance des images",
+    title="Transformée unscented : moyenne et covariance des images",
     chapter="ukf",
     signature="unscented_transform(chi, wm, wc, f) -> (mean, cov)",
     parameters=("chi", "wm", "wc", "f"),
@@ -321,7 +321,7 @@ UNSCENTED_TRANSFORM = Exercise(
                 "de (1 − α² + β). Avec wm partout, la covariance est fausse (trop petite pour β = 2).",
                 _ut_cov_with_wm, outputs=(1,), output=1),
         Mistake("f-of-mean", "f de la moyenne au lieu de la moyenne des images",
-                "La transformée sans parfum moyenne les images : ȳ = Σ wmᵢ f(χᵢ). f(x̄) est la prédiction "
+                "La transformée unscented moyenne les images : ȳ = Σ wmᵢ f(χᵢ). f(x̄) est la prédiction "
                 "linéarisée (celle de l'EKF), que la transformée cherche justement à corriger.",
                 _ut_f_of_mean, outputs=(0,), output=0),
         Mistake("not-centred", "covariance sans retrancher la moyenne",

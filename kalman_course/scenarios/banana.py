@@ -12,7 +12,7 @@ compare trois façons d'en calculer la moyenne et la covariance :
   :math:`\mathbb E[\sin\theta\cos\theta] = \tfrac12\sin 2\bar\theta\, e^{-2\sigma_\theta^2}`,
   :math:`\mathbb E[r^2] = \bar r^2 + \sigma_r^2` (un nuage de Monte-Carlo sert au dessin) ;
 * la **linéarisation** (EKF) : :math:`g(\bar r, \bar\theta)` et :math:`JPJ^T` ;
-* la **transformée sans parfum** (UKF) : :func:`~kalman_course.unscented_transform`.
+* la **transformée unscented** (UKF) : :func:`~kalman_course.unscented_transform`.
 """
 
 from __future__ import annotations
@@ -105,7 +105,7 @@ def banana_unscented(
     *, alpha: float = BANANA_ALPHA, beta: float = BANANA_BETA, kappa: float = BANANA_KAPPA,
     r: float = BANANA_RANGE, bearing: float = BANANA_BEARING,
 ):
-    r"""Transformée sans parfum de :math:`\mathcal N((\bar r, \bar\theta), \mathrm{diag}(\sigma_r^2, \sigma_\theta^2))`
+    r"""Transformée unscented de :math:`\mathcal N((\bar r, \bar\theta), \mathrm{diag}(\sigma_r^2, \sigma_\theta^2))`
     par :func:`polar_to_cartesian` ; renvoie l':class:`~kalman_course.UnscentedTransform` (avec les points sigma)."""
     sr, st = _check_std("range_std", range_std), _check_std("bearing_std", bearing_std)
     return unscented_transform(np.array([r, bearing]), np.diag([sr**2, st**2]), polar_to_cartesian,
@@ -151,7 +151,7 @@ class BananaComparison:
         freeze_fields(self, "sigma_points", "sigma_images", "Wm", "Wc")
 
     def mean_errors(self) -> tuple[float, float]:
-        """Distances (m) de la moyenne linéarisée et de la moyenne sans parfum à la vraie moyenne."""
+        """Distances (m) de la moyenne linéarisée et de la moyenne unscented à la vraie moyenne."""
         t = self.truth.mean
         return float(np.linalg.norm(self.linearized.mean - t)), float(np.linalg.norm(self.unscented.mean - t))
 
@@ -160,7 +160,7 @@ def banana_comparison(
     range_std: float = BANANA_RANGE_STD, bearing_std: float = BANANA_BEARING_STD,
     *, alpha: float = BANANA_ALPHA, beta: float = BANANA_BETA, kappa: float = BANANA_KAPPA,
 ) -> BananaComparison:
-    r"""Vérité (forme close), linéarisation et transformée sans parfum pour :math:`(\sigma_r, \sigma_\theta)`."""
+    r"""Vérité (forme close), linéarisation et transformée unscented pour :math:`(\sigma_r, \sigma_\theta)`."""
     ut = banana_unscented(range_std, bearing_std, alpha=alpha, beta=beta, kappa=kappa)
     return BananaComparison(
         truth=banana_truth(range_std, bearing_std),

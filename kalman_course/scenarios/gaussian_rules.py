@@ -1,7 +1,7 @@
 r"""Scénario du chapitre « Un seul filtre gaussien » : les règles d'intégration côte à côte.
 
 * La « banane » (:mod:`~kalman_course.scenarios.banana`) : moyenne et covariance de
-  :math:`g(r, \theta) = (r\cos\theta, r\sin\theta)` par chaque règle (linéarisation, sans parfum, cubature,
+  :math:`g(r, \theta) = (r\cos\theta, r\sin\theta)` par chaque règle (linéarisation, unscented, cubature,
   Gauss–Hermite d'ordre :math:`p`) contre la forme close ; l'erreur de la moyenne en fonction de
   :math:`\sigma_\theta` donne l'ordre de chaque règle (pente log-log).
 * :math:`h(x) = x^3` sous :math:`x \sim \mathcal N(m, s^2)` : la variance transformée par chaque règle
@@ -62,12 +62,12 @@ CUBE_STD = float(np.sqrt(0.3))
 
 
 def rules(order: int = GH_ORDER) -> dict[str, GaussianRule]:
-    r"""Les règles comparées, par nom affiché : linéarisation (EKF), sans parfum (UKF, :math:`\alpha = 1`,
+    r"""Les règles comparées, par nom affiché : linéarisation (EKF), unscented (UKF, :math:`\alpha = 1`,
     :math:`\beta = 2`, :math:`\kappa = 3 - n = 1`, celle du chapitre de l'UKF), cubature (CKF) et
     Gauss–Hermite d'ordre ``order`` (GHKF)."""
     return {
         "linéarisation (EKF)": LINEARIZATION,
-        "sans parfum (UKF)": UnscentedRule(BANANA_ALPHA, BANANA_BETA, BANANA_KAPPA),
+        "unscented (UKF)": UnscentedRule(BANANA_ALPHA, BANANA_BETA, BANANA_KAPPA),
         "cubature (CKF)": CUBATURE,
         f"Gauss–Hermite, p = {order} (GHKF)": GaussHermiteRule(order),
     }
@@ -116,7 +116,7 @@ def banana_rules(range_std: float = BANANA_RANGE_STD, bearing_std: float = BANAN
 def banana_mean_errors(bearing_stds: Any, orders: tuple[int, ...] = (3, 5),
                        range_std: float = BANANA_RANGE_STD) -> dict[str, np.ndarray]:
     r"""Distance (m) de la moyenne de chaque règle à la vraie moyenne de la banane, pour chaque
-    :math:`\sigma_\theta` de ``bearing_stds`` (rad) : linéarisation, sans parfum, cubature et Gauss–Hermite
+    :math:`\sigma_\theta` de ``bearing_stds`` (rad) : linéarisation, unscented, cubature et Gauss–Hermite
     pour chaque ordre de ``orders``. Les pentes log-log donnent l'ordre de chaque règle."""
     stds = np.atleast_1d(np.asarray(bearing_stds, dtype=float))
     names = list(rules(orders[0]))[:3] + [f"Gauss–Hermite, p = {p} (GHKF)" for p in orders]
@@ -138,7 +138,7 @@ def cube_moments(m: float = CUBE_MEAN, s: float = CUBE_STD) -> tuple[float, floa
 
 
 def cube_variance_errors(orders: Any = (2, 3, 4, 5), m: float = CUBE_MEAN, s: float = CUBE_STD) -> dict[str, float]:
-    r"""Erreur relative de :math:`\operatorname{Var}(x^3)` par chaque règle (linéarisation, sans parfum,
+    r"""Erreur relative de :math:`\operatorname{Var}(x^3)` par chaque règle (linéarisation, unscented,
     cubature, Gauss–Hermite de chaque ordre de ``orders``) contre :func:`cube_moments`."""
     _, var, _ = cube_moments(m, s)
     cube = lambda x: np.asarray(x) ** 3  # noqa: E731
@@ -154,9 +154,9 @@ def cube_variance_errors(orders: Any = (2, 3, 4, 5), m: float = CUBE_MEAN, s: fl
 
 def points_per_step(dimensions: Any = tuple(range(1, 11)), orders: tuple[int, ...] = (3, 5)) -> dict[str, np.ndarray]:
     r"""Nombre de points (d'évaluations de :math:`f` ou de :math:`h`) par étape selon la dimension :math:`n`
-    de l'état : sans parfum :math:`2n + 1`, cubature :math:`2n`, Gauss–Hermite :math:`p^n`."""
+    de l'état : unscented :math:`2n + 1`, cubature :math:`2n`, Gauss–Hermite :math:`p^n`."""
     ns = np.atleast_1d(np.asarray(dimensions, dtype=int))
-    out = {"sans parfum (UKF) : 2n + 1": 2 * ns + 1, "cubature (CKF) : 2n": 2 * ns}
+    out = {"unscented (UKF) : 2n + 1": 2 * ns + 1, "cubature (CKF) : 2n": 2 * ns}
     for p in orders:
         out[f"Gauss–Hermite, p = {p} : {p}ⁿ"] = np.array([float(p) ** n for n in ns])
     return out

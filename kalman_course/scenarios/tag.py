@@ -211,7 +211,7 @@ def run_tag_ukf(
     beta: float = TAG_UKF_BETA,
     kappa: float = TAG_UKF_KAPPA,
 ) -> FilterResult:
-    r"""Même problème avec le filtre de Kalman sans parfum du paquet
+    r"""Même problème avec le filtre de Kalman unscented du paquet
     (:func:`~kalman_course.unscented_kalman_filter`), points sigma :math:`(\alpha, \beta, \kappa)`
     (par défaut :math:`0{,}1`, 2 et :math:`3 - n = -1`)."""
     data = tag_data() if data is None else data

@@ -6,7 +6,7 @@ et les tests (qui comparent les deux).
 
 * :func:`thermometer_update` — TD 1 : une correction scalaire (a priori 20 °C, variance 4 °C² ;
   mesure 23 °C, variance 1 °C²) ;
-* :func:`square_transform` — TD 2 : la transformée sans parfum de N(0, 1) par x² (α = 1, β = 0, κ = 2)
+* :func:`square_transform` — TD 2 : la transformée unscented de N(0, 1) par x² (α = 1, β = 0, κ = 2)
   et sa linéarisation ;
 * :func:`four_particles` — TD 2 : le rééchantillonnage systématique de quatre particules ;
 * :func:`ensemble_spread` — TD 2 : la dispersion de l'analyse d'un EnKF scalaire, avec et sans
@@ -70,7 +70,7 @@ class SquareTransform:
 
 
 def square_transform() -> SquareTransform:
-    """La transformée sans parfum du TD 2 par :func:`kalman_course.unscented_transform`."""
+    """La transformée unscented du TD 2 par :func:`kalman_course.unscented_transform`."""
     alpha, beta, kappa = SQUARE_UT
     ut = unscented_transform([0.0], [[1.0]], lambda x: x**2, alpha=alpha, beta=beta, kappa=kappa)
     slope = 2.0 * 0.0  # f'(0) pour f(x) = x²
