@@ -110,7 +110,6 @@ def iekf_spec() -> SliderSpec:
                 x_range=(7.0, 10.6),
                 y_range=(-0.5, 3.9),
                 equal_aspect=True,
-                width=480,
             ),
             Panel(
                 "Distance au MAP à chaque itération",

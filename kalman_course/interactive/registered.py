@@ -16,7 +16,7 @@ from ..scenarios import banana
 from ..scenarios.convergence import LINEAR_STEPS
 from .figure import SliderSpec, register_sliders
 from .particle import particle_axes, particle_panels, particle_readout, particle_run
-from .smoothing import nile_axes, nile_panels, nile_slider_run
+from .smoothing import nile_axes, nile_panels, nile_readout, nile_slider_run
 from .unscented import (
     N_POINTS,
     banana_parameter_axes,
@@ -76,4 +76,5 @@ def nile_spec() -> SliderSpec:
         title="Le Nil filtré et lissé : déplacez R et Q (niveau local, départ diffus exact)",
         x_label="année", axes=nile_axes(), run=nile_slider_run,
         time=nile(True).year.astype(float), panels=nile_panels(), fixed={"y": nile(True).flow},
+        readout=nile_readout,
     )

@@ -318,7 +318,7 @@ class StaticSliders:
                 if panel.width is not None:
                     size = {"width": panel.width, "height": int(round(panel.width / ratio)), "sizing_mode": "fixed"}
             fig = figure(
-                title=french_spacing(panel.title),
+                # le titre du panneau est écrit par la page (HTML, il passe à la ligne) : pas dans le canevas
                 tools="pan,box_zoom,wheel_zoom,reset,save",
                 toolbar_location="right",
                 x_range=Range1d(*x_range) if panel.own_x else time_range,
@@ -512,8 +512,10 @@ class StaticSliders:
                                  "values": [french_spacing(v) for v in a.labels()]} for a in self.grid.axes],
                                ensure_ascii=False, separators=(",", ":")).replace("</", "<\\/")
         panels = "".join(
-            f'<div class="kc-bokeh-panel{" kc-bokeh-plane" if p.equal_aspect else ""}" id="{root_id}-panel-{k}" '
-            f'role="figure" aria-label="{html.escape(self.panel_label(k), quote=True)}"></div>'
+            f'<div class="kc-bokeh-panel{" kc-bokeh-plane" if p.equal_aspect else ""}" id="{root_id}-panel-{k}-box" '
+            f'role="figure" aria-label="{html.escape(self.panel_label(k), quote=True)}">'
+            f'<p class="kc-panel-title" aria-hidden="true">{html.escape(french_spacing(p.title))}</p>'
+            f'<div class="kc-bokeh-canvas" id="{root_id}-panel-{k}"></div></div>'
             for k, p in enumerate(self.panels)
         )
         return (
@@ -523,7 +525,7 @@ class StaticSliders:
             f'<p class="kc-bokeh-title" id="{root_id}-title"><strong>{title}</strong></p>\n'
             f'<div id="{root_id}" class="kc-bokeh-root" data-columns="{columns}">'
             f'<p class="kc-bokeh-missing">{missing}</p>'
-            f'<div class="kc-bokeh-controls" id="{root_id}-controls">{sliders}</div>\n{readout}'
+            f'<div class="kc-bokeh-controls" id="{root_id}-controls">{sliders}{readout}</div>\n'
             f'<div class="kc-bokeh-panels">{panels}</div></div>\n'
             f'<script type="application/json" id="{root_id}-sliders">{described}</script>\n'
             f'<script type="application/json" id="{root_id}-item">{item}</script>\n'

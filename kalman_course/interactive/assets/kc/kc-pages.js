@@ -66,14 +66,21 @@
   }
 
   var drawn = {};
+  var documents = {};
   function draw(id) {
     if (drawn[id]) return drawn[id];
     var root = document.getElementById(id);
+    var rootIds = [];
     drawn[id] = loadBokeh().then(function () { return loadData(id); }).then(function (item) {
       var missing = root.querySelector(".kc-bokeh-missing");
       if (missing) missing.parentNode.removeChild(missing);
+      rootIds = item.render_items[0].root_ids;
       return window.Bokeh.embed.embed_items(item.docs_json, item.render_items);
     }).then(function () {
+      // le document Bokeh de la figure (les tests et les outils le retrouvent par l'identifiant)
+      window.Bokeh.documents.forEach(function (doc) {
+        if (doc.get_model_by_id(rootIds[0])) documents[id] = doc;
+      });
       root.setAttribute("data-kc-ready", "1");
       announce(id);
       var handles = [];
@@ -95,7 +102,7 @@
       observer.unobserve(entry.target);
       draw(entry.target.getAttribute("data-kc-id"));
     });
-  }, {rootMargin: "600px 0px"}) : null;
+  }, {rootMargin: "300px 0px"}) : null;
 
   function register(id) {
     if (figures.indexOf(id) >= 0) return;
@@ -114,7 +121,8 @@
     return Promise.all(figures.map(draw));
   }
 
-  window.kcFigures = {register: register, draw: draw, loadAll: loadAll, announce: announce, figures: figures};
+  window.kcFigures = {register: register, draw: draw, loadAll: loadAll, announce: announce, figures: figures,
+                      documents: documents};
   window.addEventListener("beforeprint", loadAll);
 
   // ------------------------------------------------------------------ la page
@@ -124,8 +132,22 @@
     else fn();
   }
 
+  // Hauteur de l'en-tête collant du thème : les curseurs se collent juste dessous.
+  function stickyTop() {
+    var top = 0;
+    document.querySelectorAll(".bd-header, .bd-header-article, .header-article").forEach(function (el) {
+      var style = window.getComputedStyle(el);
+      if ((style.position === "sticky" || style.position === "fixed") && style.display !== "none") {
+        top = Math.max(top, el.getBoundingClientRect().height);
+      }
+    });
+    document.documentElement.style.setProperty("--kc-sticky-top", Math.round(top) + "px");
+  }
+
   onReady(function () {
     document.querySelectorAll(".kc-bokeh-root").forEach(function (r) { register(r.id); });
+    stickyTop();
+    window.addEventListener("resize", stickyTop);
 
     // Lien d'évitement vers la première figure à curseurs, juste après « aller au contenu » du thème.
     var first = document.querySelector(".kc-bokeh-figure");
@@ -151,7 +173,7 @@
     // Équations hors cadre (petit écran) : défilement horizontal, au clavier aussi.
     var scrollable = function () {
       document.querySelectorAll("mjx-container[display='true']").forEach(function (m) {
-        var box = m.closest(".math") || m;
+        var box = m.closest("div.math") || m.parentElement;
         if (box.scrollWidth > box.clientWidth + 1) {
           box.setAttribute("tabindex", "0");
           if (!box.getAttribute("aria-label")) box.setAttribute("aria-label", "Formule (défilement horizontal)");
