@@ -10,7 +10,7 @@
    poignée) à la recopie des données (rappel CustomJS), puis à la fin du rendu des panneaux par BokehJS
    (fin du dernier requestAnimationFrame qu'il a demandé) ; objectif < 50 ms.
 
-Usage : python benchmarks/interactive.py [--site _build/html] [--moves 40]
+Usage : python benchmarks/interactive.py [--site _build/html] [--moves 40] [--only grilles,poids,réponse]
 """
 
 from __future__ import annotations
@@ -153,98 +153,111 @@ _INSTALL = """(id) => {
 }""" % PLOTTED_SOURCE
 
 
-def bench_browser(root: Path, moves: int) -> None:
+def bench_browser(root: Path, moves: int, sections: set[str]) -> None:
     from playwright.sync_api import sync_playwright
 
     server, base = serve(root)
     try:
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
-            print("\n2. Poids des pages (octets des fichiers servis ; portable 1366 × 768)")
-            print(f"   {'page':36s} {'1er chargement':>15s} {'requêtes':>9s} {'figures comprises':>18s} "
-                  f"{'1er rendu':>10s}")
-            firsts, paints = [], []
-            for rel in [PLAIN_PAGE, *PAGES]:
-                html_file = root / rel
-                if not html_file.is_file():
-                    print(f"   {rel} : absente du site")
-                    continue
-                page, loaded, blocked = open_page(browser, base + rel, base)
-                page.wait_for_timeout(300)
-                first, n_first = served(root, loaded)
-                paint = page.evaluate("() => (performance.getEntriesByName('first-contentful-paint')[0] || "
-                                      "{startTime: NaN}).startTime")
-                load_figures(page)
-                full, _ = served(root, loaded)
-                ok = "" if first <= 2.5e6 else "  MANQUÉ (> 2,5 Mo)"
-                print(f"   {rel:36s} {format_spec(first / 1e6, '.2f'):>12s} Mo {format_spec(n_first, 'd'):>9s} "
-                      f"{format_spec(full / 1e6, '.2f'):>15s} Mo {format_spec(paint, '.0f'):>7s} ms{ok}")
-                if blocked:
-                    print(f"     REQUÊTES NON LOCALES BLOQUÉES : {blocked}")
-                if rel != PLAIN_PAGE:
-                    firsts.append(first)
-                    paints.append(paint)
-                page.close()
-            if firsts:
-                worst, slow = max(firsts), max(paints)
-                print(f"   chapitres : premier chargement de {format_spec(min(firsts) / 1e6, '.2f')} à "
-                      f"{format_spec(worst / 1e6, '.2f')} Mo (objectif ≤ 2,5 Mo : "
-                      f"{'atteint' if worst <= 2.5e6 else 'MANQUÉ'}) ; premier rendu médian "
-                      f"{format_spec(statistics.median(paints), '.0f')} ms, au plus {format_spec(slow, '.0f')} ms "
-                      f"(objectif < 1 000 ms : {'atteint' if slow < 1000 else 'MANQUÉ'})")
-
-            print(f"\n3. Réponse des curseurs dans Chromium headless "
-                  f"({format_spec(moves, 'd')} déplacements au clavier par curseur)")
-            for rel in PAGES:
-                html_file = root / rel
-                if not html_file.is_file() or MARKER not in html_file.read_text():
-                    continue
-                page, _, _ = open_page(browser, base + rel, base)
-                load_figures(page)
-                figures = page.locator(f"[{MARKER}]")
-                ids = page.evaluate("() => [...document.querySelectorAll('.kc-bokeh-root')].map(r => r.id)")
-                for k in range(figures.count()):
-                    name = figures.nth(k).get_attribute(MARKER)
-                    page.locator(f"[{MARKER}] .noUi-handle").first.wait_for()
-                    page.evaluate(_INSTALL, ids[k])
-                    k = ids[k]
-                    n_sliders = figures.nth(k).locator(".noUi-handle").count()
-                    for s in range(n_sliders):
-                        handle = figures.nth(k).locator(".noUi-handle").nth(s)
-                        handle.focus()
-                        page.keyboard.press("Home")
-                        page.wait_for_timeout(300)
-                        page.evaluate("() => { window.kcMoves = []; }")
-                        n_pos = int(page.evaluate(f"() => kcFigures.documents['{k}'].get_model_by_name('kc-slider-{s}').end"))
-                        key = "ArrowRight"
-                        for m in range(moves):
-                            value = page.evaluate(f"() => kcFigures.documents['{k}'].get_model_by_name('kc-slider-{s}').value")
-                            if value >= n_pos:
-                                key = "ArrowLeft"
-                            elif value <= 0:
-                                key = "ArrowRight"
-                            page.keyboard.press(key)
-                            page.wait_for_timeout(150)  # laisser finir le rendu avant le mouvement suivant
-                        done = [m for m in page.evaluate("() => window.kcMoves") if m["tPaint"] is not None]
-                        data_ms = [m["tData"] for m in done]
-                        paint_ms = [m["tPaint"] for m in done]
-                        label = page.evaluate(f"() => kcFigures.documents['{k}'].get_model_by_name('kc-slider-{s}').title")
-                        med, p90 = statistics.median(paint_ms), statistics.quantiles(paint_ms, n=10)[-1]
-                        worst = max(paint_ms)
-                        ninety = format_spec(0.9, ".0%")
-                        verdict = "atteint" if worst < 50 else (f"atteint pour {ninety} des mouvements" if p90 < 50
-                                                               else "MANQUÉ")
-                        data_med = format_spec(statistics.median(data_ms), ".1f")
-                        print(f"   {name}, « {label} » ({format_spec(len(done), 'd')} mouvements) :\n"
-                              f"     données recopiées : médiane {data_med:>5s} ms, "
-                              f"max {format_spec(max(data_ms), '.1f'):>5s} ms\n"
-                              f"     figure redessinée : médiane {format_spec(med, '.1f'):>5s} ms, "
-                              f"{ninety} {format_spec(p90, '.1f'):>5s} ms, max {format_spec(worst, '.1f'):>5s} ms"
-                              f" — objectif < 50 ms : {verdict}")
-                page.close()
+            if "poids" in sections:
+                bench_weights(browser, root, base)
+            if "réponse" in sections:
+                bench_response(browser, root, base, moves)
             browser.close()
     finally:
         server.shutdown()
+
+
+def bench_weights(browser, root: Path, base: str) -> None:
+    print("\n2. Poids des pages (octets des fichiers servis ; portable 1366 × 768)")
+    print(f"   {'page':36s} {'1er chargement':>15s} {'requêtes':>9s} {'figures comprises':>18s} "
+          f"{'1er rendu':>10s}")
+    firsts, paints = [], []
+    for rel in [PLAIN_PAGE, *PAGES]:
+        html_file = root / rel
+        if not html_file.is_file():
+            print(f"   {rel} : absente du site")
+            continue
+        page, loaded, blocked = open_page(browser, base + rel, base)
+        page.wait_for_timeout(300)
+        first, n_first = served(root, loaded)
+        paint = page.evaluate("() => (performance.getEntriesByName('first-contentful-paint')[0] || "
+                              "{startTime: NaN}).startTime")
+        load_figures(page)
+        full, _ = served(root, loaded)
+        ok = "" if first <= 2.5e6 else "  MANQUÉ (> 2,5 Mo)"
+        print(f"   {rel:36s} {format_spec(first / 1e6, '.2f'):>12s} Mo {format_spec(n_first, 'd'):>9s} "
+              f"{format_spec(full / 1e6, '.2f'):>15s} Mo {format_spec(paint, '.0f'):>7s} ms{ok}")
+        if blocked:
+            print(f"     REQUÊTES NON LOCALES BLOQUÉES : {blocked}")
+        if rel != PLAIN_PAGE:
+            firsts.append(first)
+            paints.append(paint)
+        page.close()
+    if firsts:
+        worst, slow = max(firsts), max(paints)
+        print(f"   chapitres : premier chargement de {format_spec(min(firsts) / 1e6, '.2f')} à "
+              f"{format_spec(worst / 1e6, '.2f')} Mo (objectif ≤ 2,5 Mo : "
+              f"{'atteint' if worst <= 2.5e6 else 'MANQUÉ'}) ; premier rendu médian "
+              f"{format_spec(statistics.median(paints), '.0f')} ms, au plus {format_spec(slow, '.0f')} ms "
+              f"(objectif < 1 000 ms : {'atteint' if slow < 1000 else 'MANQUÉ'})")
+
+
+def bench_response(browser, root: Path, base: str, moves: int) -> None:
+    print(f"\n3. Réponse des curseurs dans Chromium headless "
+          f"({format_spec(moves, 'd')} déplacements au clavier par curseur)")
+    for rel in PAGES:
+        html_file = root / rel
+        if not html_file.is_file() or MARKER not in html_file.read_text():
+            continue
+        page, _, _ = open_page(browser, base + rel, base)
+        load_figures(page)
+        figures = page.locator(f"[{MARKER}]")
+        ids = page.evaluate("() => [...document.querySelectorAll('.kc-bokeh-root')].map(r => r.id)")
+        for k in range(figures.count()):
+            figure, fid = figures.nth(k), ids[k]
+            name = figure.get_attribute(MARKER)
+            page.locator(f"[{MARKER}] .noUi-handle").first.wait_for()
+            page.evaluate(_INSTALL, fid)
+            n_sliders = figure.locator(".noUi-handle").count()
+            for s in range(n_sliders):
+                handle = figure.locator(".noUi-handle").nth(s)
+                handle.focus()
+                page.keyboard.press("Home")
+                page.wait_for_timeout(300)
+                page.evaluate("() => { window.kcMoves = []; }")
+                model = f"kcFigures.documents['{fid}'].get_model_by_name('kc-slider-{s}')"
+                n_pos = int(page.evaluate(f"() => {model}.end"))
+                key = "ArrowRight"
+                for m in range(moves):
+                    value = page.evaluate(f"() => {model}.value")
+                    if value >= n_pos:
+                        key = "ArrowLeft"
+                    elif value <= 0:
+                        key = "ArrowRight"
+                    page.keyboard.press(key)
+                    page.wait_for_timeout(150)  # laisser finir le rendu avant le mouvement suivant
+                done = [m for m in page.evaluate("() => window.kcMoves") if m["tPaint"] is not None]
+                if len(done) < 2:
+                    print(f"   {name}, curseur {format_spec(s + 1, 'd')} : pas assez de mouvements redessinés")
+                    continue
+                data_ms = [m["tData"] for m in done]
+                paint_ms = [m["tPaint"] for m in done]
+                label = page.evaluate(f"() => {model}.title").strip()
+                med, p90 = statistics.median(paint_ms), statistics.quantiles(paint_ms, n=10, method="inclusive")[-1]
+                worst = max(paint_ms)
+                ninety = format_spec(0.9, ".0%")
+                verdict = "atteint" if worst < 50 else (f"atteint pour {ninety} des mouvements" if p90 < 50
+                                                       else "MANQUÉ")
+                data_med = format_spec(statistics.median(data_ms), ".1f")
+                print(f"   {name}, « {label} » ({format_spec(len(done), 'd')} mouvements) :\n"
+                      f"     données recopiées : médiane {data_med:>5s} ms, "
+                      f"max {format_spec(max(data_ms), '.1f'):>5s} ms\n"
+                      f"     figure redessinée : médiane {format_spec(med, '.1f'):>5s} ms, "
+                      f"{ninety} {format_spec(p90, '.1f'):>5s} ms, max {format_spec(worst, '.1f'):>5s} ms"
+                      f" — objectif < 50 ms : {verdict}")
+        page.close()
 
 
 def load_note() -> str:
@@ -261,12 +274,21 @@ def main() -> int:
     parser = argparse.ArgumentParser(description="Mesures de l'interactivité du livre (grilles, poids, réponse).")
     parser.add_argument("--site", type=Path, default=Path("_build/html"), help="dossier html du site construit")
     parser.add_argument("--moves", type=int, default=40, help="déplacements mesurés par curseur")
+    parser.add_argument("--only", default="grilles,poids,réponse",
+                        help="mesures à faire, séparées par des virgules : grilles, poids, réponse")
     args = parser.parse_args()
-    bench_grids()
+    sections = {x.strip() for x in args.only.split(",")}
+    unknown = sections - {"grilles", "poids", "réponse"}
+    if unknown:
+        parser.error(f"mesure inconnue : {', '.join(sorted(unknown))} (grilles, poids, réponse)")
+    if "grilles" in sections:
+        bench_grids()
+    if not sections & {"poids", "réponse"}:
+        return 0
     if not (args.site / PAGES[0]).is_file():
         print(f"\n(site absent dans {args.site} : construisez le livre pour mesurer le poids et la réponse)")
         return 0
-    bench_browser(args.site.resolve(), args.moves)
+    bench_browser(args.site.resolve(), args.moves, sections)
     print(f"\n({load_note()} ; les maxima dépendent de la charge, les médianes bougent peu)")
     return 0
 

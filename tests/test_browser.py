@@ -381,7 +381,8 @@ def _check_plotted(page, fid: str, grid, root, name: str | None = None) -> tuple
     for series, values in expected.items():
         np.testing.assert_allclose(np.array(state["data"][series], dtype=float), values, rtol=1e-12, atol=0,
                                    equal_nan=True, err_msg=f"série {series}, point {index}")
-    np.testing.assert_array_equal(state["data"]["t"], grid.time)
+    if "t" in state["data"]:  # temps commun, s'il est tracé (des figures n'ont que des abscisses propres)
+        np.testing.assert_array_equal(state["data"]["t"], grid.time)
     # les curseurs affichent les vraies valeurs du point de grille…
     shown = [root.locator(".bk-slider-value").nth(s).text_content() for s in range(len(grid.axes))]
     labels = [french_spacing(axis.labels()[i]) for axis, i in zip(grid.axes, index)]
@@ -438,12 +439,12 @@ def test_static_sliders_show_the_package_runs(site, browser, capsys):
         page = visit.page
         figures = page.locator(f"[{MARKER}]")
         ids = figure_ids(page)
-        for k in range(figures.count()):
-            fig_name = figures.nth(k).get_attribute(MARKER)
-            k = ids[k]  # la figure est relue par son identifiant
+        for j in range(figures.count()):
+            fig_name = figures.nth(j).get_attribute(MARKER)
+            root = figures.nth(j)
+            k = ids[j]  # la figure est relue par son identifiant
             assert fig_name in EXPECTED_GRIDS, f"figure « {fig_name} » inconnue du test : ajoutez sa grille"
             grid = EXPECTED_GRIDS[fig_name]()
-            root = figures.nth(k)
             check = functools.partial(_check_plotted, name=fig_name)
             # position par défaut = la figure statique du chapitre
             assert check(page, k, grid, root) == grid.default_index
@@ -574,11 +575,11 @@ def test_every_chapter_has_a_slider_that_changes_the_plotted_data(site, browser)
             page.context.close()
             continue
         ids = figure_ids(page)
-        for k in range(figures.count()):
-            fig_name = figures.nth(k).get_attribute(MARKER)
-            root = figures.nth(k)
+        for j in range(figures.count()):
+            fig_name = figures.nth(j).get_attribute(MARKER)
+            root = figures.nth(j)
             grid = EXPECTED_GRIDS[fig_name]()
-            k = ids[k]  # la figure est relue par son identifiant
+            k = ids[j]  # la figure est relue par son identifiant
             for s in range(len(grid.axes)):
                 before = _plotted(page, k)
                 handle = root.locator(".noUi-handle").nth(s)
@@ -644,12 +645,14 @@ def test_every_quiz_marks_a_right_and_a_wrong_answer(site, browser):
 _PANELS_IN_VIEW = r"""(id) => {
   // chaque panneau, amené en bas de l'écran : les curseurs (collés sous l'en-tête) et tout le panneau
   // sont visibles ensemble
+  // (bas des en-têtes du thème encore à l'écran : l'en-tête du site défile, celui de l'article colle)
   const controls = document.getElementById(id + '-controls');
-  const header = document.querySelector('.bd-header');
-  const top = header ? header.getBoundingClientRect().bottom : 0;
+  const headerBottom = () => Math.max(0, ...[...document.querySelectorAll('.bd-header, .bd-header-article')]
+    .filter(h => getComputedStyle(h).display !== 'none').map(h => h.getBoundingClientRect().bottom));
   const out = [];
   for (const panel of document.getElementById(id).querySelectorAll('.kc-bokeh-panel')) {
     panel.scrollIntoView({block: 'end'});
+    const top = headerBottom();
     const p = panel.getBoundingClientRect(), c = controls.getBoundingClientRect();
     out.push({panel: panel.id, height: Math.round(p.height), controls: Math.round(c.height),
               ok: c.top >= top - 1 && c.bottom <= p.top + 1 && p.bottom <= window.innerHeight + 1 && p.height > 50});
@@ -688,7 +691,7 @@ _PHONE = r"""() => {
                cut: [], values: []};
   const column = document.querySelector('main .bd-article, main article, main');
   const width = column ? column.getBoundingClientRect().width : window.innerWidth;
-  for (const el of document.querySelectorAll('.kc-bokeh-panel, .kc-bokeh-slider, img, object, svg.mermaid')) {
+  for (const el of document.querySelectorAll('main .kc-bokeh-panel, main .kc-bokeh-slider, main img, main object')) {
     const b = el.getBoundingClientRect();
     if (b.width > 0 && (b.right > window.innerWidth + 1 || b.left < -1)) out.wide.push(el.id || el.tagName);
   }

@@ -81,6 +81,8 @@
       window.Bokeh.documents.forEach(function (doc) {
         if (doc.get_model_by_id(rootIds[0])) documents[id] = doc;
       });
+      // titre « nom : valeur » des curseurs : sur un téléphone, il passe à la ligne (la valeur reste lisible)
+      deepAll(root, ".bk-slider-title").forEach(function (t) { t.style.whiteSpace = "normal"; });
       root.setAttribute("data-kc-ready", "1");
       announce(id);
       var handles = [];
@@ -148,6 +150,14 @@
     document.querySelectorAll(".kc-bokeh-root").forEach(function (r) { register(r.id); });
     stickyTop();
     window.addEventListener("resize", stickyTop);
+    window.addEventListener("load", stickyTop);
+    // l'en-tête grandit quand ses polices et ses boutons arrivent : suivre sa hauteur
+    if (window.ResizeObserver) {
+      var watch = new ResizeObserver(stickyTop);
+      document.querySelectorAll(".bd-header, .bd-header-article, .header-article").forEach(function (el) {
+        watch.observe(el);
+      });
+    }
 
     // Lien d'évitement vers la première figure à curseurs, juste après « aller au contenu » du thème.
     var first = document.querySelector(".kc-bokeh-figure");
@@ -197,12 +207,14 @@
     window.addEventListener("resize", scrollable);
 
     // Recherche : extraits sans TeX brut.
-    if (window.Search && window.Search.makeSearchSummary && !window.Search.kcReadable) {
-      var original = window.Search.makeSearchSummary;
-      window.Search.makeSearchSummary = function (htmlText, keywords, anchor) {
+    // (searchtools.js de Sphinx 7 déclare « const Search » : nom global, mais pas propriété de window)
+    var search = typeof Search !== "undefined" ? Search : window.Search;  // eslint-disable-line no-undef
+    if (search && search.makeSearchSummary && !search.kcReadable) {
+      var original = search.makeSearchSummary;
+      search.makeSearchSummary = function (htmlText, keywords, anchor) {
         return original.call(this, readableMath(htmlText), keywords, anchor);
       };
-      window.Search.kcReadable = true;
+      search.kcReadable = true;
     }
   });
 
