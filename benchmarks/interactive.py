@@ -2,13 +2,15 @@
 
 1. Précalcul des grilles : 15 × 15 exécutions de 50 pas (tension constante), objectif < 1 s ;
    puis chaque figure à curseurs du registre (une par chapitre au moins), pour information.
-2. Poids de la page interactive (site construit) : HTML propre + données précalculées + images, objectif
-   < 1 Mo ; scripts partagés par tout le site (BokehJS, MathJax, thème), chargés une fois, à part.
+2. Poids des pages (site construit, portable 1366 × 768) : au premier chargement (ce que la page charge
+   avant qu'une figure à curseurs n'approche de l'écran), objectif ≤ 2,5 Mo par chapitre ; puis figures
+   comprises (BokehJS et exécutions précalculées, chargés à la demande) ; premier rendu (« first
+   contentful paint ») servi par un serveur local, objectif < 1 s.
 3. Réponse des curseurs dans Chromium headless : de l'événement clavier réel (touche flèche sur la
    poignée) à la recopie des données (rappel CustomJS), puis à la fin du rendu des panneaux par BokehJS
    (fin du dernier requestAnimationFrame qu'il a demandé) ; objectif < 50 ms.
 
-Usage : python benchmarks/interactive.py [--site _build/html] [--moves 40]
+Usage : python benchmarks/interactive.py [--site _build/html] [--moves 40] [--only grilles,poids,réponse]
 """
 
 from __future__ import annotations
@@ -16,7 +18,6 @@ from __future__ import annotations
 import argparse
 import functools
 import http.server
-import re
 import statistics
 import threading
 import time
@@ -93,7 +94,7 @@ def serve(root: Path):
 
 
 def open_page(browser, url: str, base: str):
-    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page = browser.new_page(viewport={"width": 1366, "height": 768})
     loaded, blocked = [], []
 
     def route(r):
@@ -110,31 +111,27 @@ def open_page(browser, url: str, base: str):
     return page, loaded, blocked
 
 
-def weight(root: Path, html_file: Path, loaded: list[str]) -> dict[str, int]:
-    html = html_file.read_text()
-    data = sum(len(m.encode()) for m in re.findall(r'<script type="application/json" id="kc-[^"]*">(.*?)</script>',
-                                                     html, re.S))
-    images = {(html_file.parent / s).resolve() for s in re.findall(r'<img[^>]+src="([^"]+)"', html)}
-    out = {"html": html_file.stat().st_size - data, "data": data,
-           "images": sum(f.stat().st_size for f in images if f.is_file()), "bokeh": 0, "mathjax": 0, "theme": 0}
-    for url in dict.fromkeys(loaded):
-        f = (root / urlsplit(url).path.lstrip("/")).resolve()
-        if not f.is_file() or f == html_file.resolve() or f in images:
-            continue
-        rel = f.relative_to(root.resolve()).as_posix()
-        key = "bokeh" if rel.startswith("_static/bokeh/") else "mathjax" if rel.startswith("_static/mathjax/") \
-            else None if rel.startswith("_images/") else "theme"
-        if key:
-            out[key] += f.stat().st_size
-    return out
+def load_figures(page) -> None:
+    """Dessine toutes les figures à curseurs (elles se chargent d'ordinaire en approchant de l'écran)."""
+    if page.evaluate("() => !!window.kcFigures && document.querySelectorAll('.kc-bokeh-root').length > 0"):
+        page.evaluate("() => window.kcFigures.loadAll().then(() => true)")
+        page.wait_for_function("() => [...document.querySelectorAll('.kc-bokeh-root')].every(r => "
+                               "r.dataset.kcReady === '1')", timeout=30000)
 
 
-_INSTALL = """(k) => {
+def served(root: Path, urls) -> tuple[int, int]:
+    """(octets, nombre de fichiers) des fichiers du site servis pour ces adresses (chacune une fois)."""
+    files = [(root / urlsplit(u).path.lstrip("/")) for u in dict.fromkeys(urls)]
+    files = [f for f in files if f.is_file()]
+    return sum(f.stat().st_size for f in files), len(files)
+
+
+_INSTALL = """(id) => {
   // t0 : horodatage de l'événement clavier réel (même horloge que performance.now()) ;
   // tData : le document Bokeh signale le changement des données tracées (rappel CustomJS terminé) ;
   // tPaint : fin du dernier rendu que BokehJS a demandé (requestAnimationFrame) après cet événement,
   // c'est-à-dire les trois panneaux redessinés.
-  const doc = Bokeh.documents[k];
+  const doc = window.kcFigures.documents[id];
   window.kcMoves = [];
   let current = null;
   document.addEventListener('keydown', (e) => {
@@ -156,88 +153,111 @@ _INSTALL = """(k) => {
 }""" % PLOTTED_SOURCE
 
 
-def bench_browser(root: Path, moves: int) -> None:
+def bench_browser(root: Path, moves: int, sections: set[str]) -> None:
     from playwright.sync_api import sync_playwright
 
     server, base = serve(root)
     try:
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
-            print("\n2. Poids des pages (octets des fichiers chargés ; scripts partagés chargés une fois par site)")
-            for rel in [PLAIN_PAGE, *PAGES]:
-                html_file = root / rel
-                if not html_file.is_file():
-                    print(f"   {rel} : absente du site")
-                    continue
-                page, loaded, blocked = open_page(browser, base + rel, base)
-                page.wait_for_timeout(500)
-                w = weight(root, html_file, loaded)
-                own = w["html"] + w["data"] + w["images"]
-                shared = w["bokeh"] + w["mathjax"] + w["theme"]
-                target = ""
-                if MARKER in html_file.read_text():
-                    target = f"  (objectif < 1 Mo : {'atteint' if own < 1e6 else 'MANQUÉ'})"
-                print(f"   {rel}")
-                ko = {key: format_spec(w[key] / 1e3, ".0f") for key in ("html", "data", "images")}
-                mo = {key: format_spec(w[key] / 1e6, ".3f") for key in ("bokeh", "mathjax", "theme")}
-                print(f"     propre : HTML {ko['html']:>6s} ko + données {ko['data']:>6s} ko + images "
-                      f"{ko['images']:>6s} ko = {format_spec(own / 1e6, '.3f')} Mo{target}")
-                print(f"     partagé : BokehJS {mo['bokeh']} Mo, MathJax {mo['mathjax']} Mo, "
-                      f"thème {mo['theme']} Mo ; total chargé {format_spec((own + shared) / 1e6, '.3f')} Mo")
-                if blocked:
-                    print(f"     REQUÊTES NON LOCALES BLOQUÉES : {blocked}")
-                page.close()
-
-            print(f"\n3. Réponse des curseurs dans Chromium headless "
-                  f"({format_spec(moves, 'd')} déplacements au clavier par curseur)")
-            for rel in PAGES:
-                html_file = root / rel
-                if not html_file.is_file() or MARKER not in html_file.read_text():
-                    continue
-                page, _, _ = open_page(browser, base + rel, base)
-                page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0")
-                figures = page.locator(f"[{MARKER}]")
-                for k in range(figures.count()):
-                    name = figures.nth(k).get_attribute(MARKER)
-                    page.locator(f"[{MARKER}] .noUi-handle").first.wait_for()
-                    page.evaluate(_INSTALL, k)
-                    n_sliders = figures.nth(k).locator(".noUi-handle").count()
-                    for s in range(n_sliders):
-                        handle = figures.nth(k).locator(".noUi-handle").nth(s)
-                        handle.focus()
-                        page.keyboard.press("Home")
-                        page.wait_for_timeout(300)
-                        page.evaluate("() => { window.kcMoves = []; }")
-                        n_pos = int(page.evaluate(f"() => Bokeh.documents[{k}].get_model_by_name('kc-slider-{s}').end"))
-                        key = "ArrowRight"
-                        for m in range(moves):
-                            value = page.evaluate(f"() => Bokeh.documents[{k}].get_model_by_name('kc-slider-{s}').value")
-                            if value >= n_pos:
-                                key = "ArrowLeft"
-                            elif value <= 0:
-                                key = "ArrowRight"
-                            page.keyboard.press(key)
-                            page.wait_for_timeout(150)  # laisser finir le rendu avant le mouvement suivant
-                        done = [m for m in page.evaluate("() => window.kcMoves") if m["tPaint"] is not None]
-                        data_ms = [m["tData"] for m in done]
-                        paint_ms = [m["tPaint"] for m in done]
-                        label = page.evaluate(f"() => Bokeh.documents[{k}].get_model_by_name('kc-slider-{s}').title")
-                        med, p90 = statistics.median(paint_ms), statistics.quantiles(paint_ms, n=10)[-1]
-                        worst = max(paint_ms)
-                        ninety = format_spec(0.9, ".0%")
-                        verdict = "atteint" if worst < 50 else (f"atteint pour {ninety} des mouvements" if p90 < 50
-                                                               else "MANQUÉ")
-                        data_med = format_spec(statistics.median(data_ms), ".1f")
-                        print(f"   {name}, « {label} » ({format_spec(len(done), 'd')} mouvements) :\n"
-                              f"     données recopiées : médiane {data_med:>5s} ms, "
-                              f"max {format_spec(max(data_ms), '.1f'):>5s} ms\n"
-                              f"     figure redessinée : médiane {format_spec(med, '.1f'):>5s} ms, "
-                              f"{ninety} {format_spec(p90, '.1f'):>5s} ms, max {format_spec(worst, '.1f'):>5s} ms"
-                              f" — objectif < 50 ms : {verdict}")
-                page.close()
+            if "poids" in sections:
+                bench_weights(browser, root, base)
+            if "réponse" in sections:
+                bench_response(browser, root, base, moves)
             browser.close()
     finally:
         server.shutdown()
+
+
+def bench_weights(browser, root: Path, base: str) -> None:
+    print("\n2. Poids des pages (octets des fichiers servis ; portable 1366 × 768)")
+    print(f"   {'page':36s} {'1er chargement':>15s} {'requêtes':>9s} {'figures comprises':>18s} "
+          f"{'1er rendu':>10s}")
+    firsts, paints = [], []
+    for rel in [PLAIN_PAGE, *PAGES]:
+        html_file = root / rel
+        if not html_file.is_file():
+            print(f"   {rel} : absente du site")
+            continue
+        page, loaded, blocked = open_page(browser, base + rel, base)
+        page.wait_for_timeout(300)
+        first, n_first = served(root, loaded)
+        paint = page.evaluate("() => (performance.getEntriesByName('first-contentful-paint')[0] || "
+                              "{startTime: NaN}).startTime")
+        load_figures(page)
+        full, _ = served(root, loaded)
+        ok = "" if first <= 2.5e6 else "  MANQUÉ (> 2,5 Mo)"
+        print(f"   {rel:36s} {format_spec(first / 1e6, '.2f'):>12s} Mo {format_spec(n_first, 'd'):>9s} "
+              f"{format_spec(full / 1e6, '.2f'):>15s} Mo {format_spec(paint, '.0f'):>7s} ms{ok}")
+        if blocked:
+            print(f"     REQUÊTES NON LOCALES BLOQUÉES : {blocked}")
+        if rel != PLAIN_PAGE:
+            firsts.append(first)
+            paints.append(paint)
+        page.close()
+    if firsts:
+        worst, slow = max(firsts), max(paints)
+        print(f"   chapitres : premier chargement de {format_spec(min(firsts) / 1e6, '.2f')} à "
+              f"{format_spec(worst / 1e6, '.2f')} Mo (objectif ≤ 2,5 Mo : "
+              f"{'atteint' if worst <= 2.5e6 else 'MANQUÉ'}) ; premier rendu médian "
+              f"{format_spec(statistics.median(paints), '.0f')} ms, au plus {format_spec(slow, '.0f')} ms "
+              f"(objectif < 1 000 ms : {'atteint' if slow < 1000 else 'MANQUÉ'})")
+
+
+def bench_response(browser, root: Path, base: str, moves: int) -> None:
+    print(f"\n3. Réponse des curseurs dans Chromium headless "
+          f"({format_spec(moves, 'd')} déplacements au clavier par curseur)")
+    for rel in PAGES:
+        html_file = root / rel
+        if not html_file.is_file() or MARKER not in html_file.read_text():
+            continue
+        page, _, _ = open_page(browser, base + rel, base)
+        load_figures(page)
+        figures = page.locator(f"[{MARKER}]")
+        ids = page.evaluate("() => [...document.querySelectorAll('.kc-bokeh-root')].map(r => r.id)")
+        for k in range(figures.count()):
+            figure, fid = figures.nth(k), ids[k]
+            name = figure.get_attribute(MARKER)
+            page.locator(f"[{MARKER}] .noUi-handle").first.wait_for()
+            page.evaluate(_INSTALL, fid)
+            n_sliders = figure.locator(".noUi-handle").count()
+            for s in range(n_sliders):
+                handle = figure.locator(".noUi-handle").nth(s)
+                handle.focus()
+                page.keyboard.press("Home")
+                page.wait_for_timeout(300)
+                page.evaluate("() => { window.kcMoves = []; }")
+                model = f"kcFigures.documents['{fid}'].get_model_by_name('kc-slider-{s}')"
+                n_pos = int(page.evaluate(f"() => {model}.end"))
+                key = "ArrowRight"
+                for m in range(moves):
+                    value = page.evaluate(f"() => {model}.value")
+                    if value >= n_pos:
+                        key = "ArrowLeft"
+                    elif value <= 0:
+                        key = "ArrowRight"
+                    page.keyboard.press(key)
+                    page.wait_for_timeout(150)  # laisser finir le rendu avant le mouvement suivant
+                done = [m for m in page.evaluate("() => window.kcMoves") if m["tPaint"] is not None]
+                if len(done) < 2:
+                    print(f"   {name}, curseur {format_spec(s + 1, 'd')} : pas assez de mouvements redessinés")
+                    continue
+                data_ms = [m["tData"] for m in done]
+                paint_ms = [m["tPaint"] for m in done]
+                label = page.evaluate(f"() => {model}.title").strip()
+                med, p90 = statistics.median(paint_ms), statistics.quantiles(paint_ms, n=10, method="inclusive")[-1]
+                worst = max(paint_ms)
+                ninety = format_spec(0.9, ".0%")
+                verdict = "atteint" if worst < 50 else (f"atteint pour {ninety} des mouvements" if p90 < 50
+                                                       else "MANQUÉ")
+                data_med = format_spec(statistics.median(data_ms), ".1f")
+                print(f"   {name}, « {label} » ({format_spec(len(done), 'd')} mouvements) :\n"
+                      f"     données recopiées : médiane {data_med:>5s} ms, "
+                      f"max {format_spec(max(data_ms), '.1f'):>5s} ms\n"
+                      f"     figure redessinée : médiane {format_spec(med, '.1f'):>5s} ms, "
+                      f"{ninety} {format_spec(p90, '.1f'):>5s} ms, max {format_spec(worst, '.1f'):>5s} ms"
+                      f" — objectif < 50 ms : {verdict}")
+        page.close()
 
 
 def load_note() -> str:
@@ -254,12 +274,21 @@ def main() -> int:
     parser = argparse.ArgumentParser(description="Mesures de l'interactivité du livre (grilles, poids, réponse).")
     parser.add_argument("--site", type=Path, default=Path("_build/html"), help="dossier html du site construit")
     parser.add_argument("--moves", type=int, default=40, help="déplacements mesurés par curseur")
+    parser.add_argument("--only", default="grilles,poids,réponse",
+                        help="mesures à faire, séparées par des virgules : grilles, poids, réponse")
     args = parser.parse_args()
-    bench_grids()
+    sections = {x.strip() for x in args.only.split(",")}
+    unknown = sections - {"grilles", "poids", "réponse"}
+    if unknown:
+        parser.error(f"mesure inconnue : {', '.join(sorted(unknown))} (grilles, poids, réponse)")
+    if "grilles" in sections:
+        bench_grids()
+    if not sections & {"poids", "réponse"}:
+        return 0
     if not (args.site / PAGES[0]).is_file():
         print(f"\n(site absent dans {args.site} : construisez le livre pour mesurer le poids et la réponse)")
         return 0
-    bench_browser(args.site.resolve(), args.moves)
+    bench_browser(args.site.resolve(), args.moves, sections)
     print(f"\n({load_note()} ; les maxima dépendent de la charge, les médianes bougent peu)")
     return 0
 

@@ -21,7 +21,9 @@ MATHJAX = ROOT / "node_modules" / "mathjax" / "es5"
 
 # Sous-ensemble de MathJax 3 utile au site (24 Mo → ~3 Mo) : composant TeX + CommonHTML, polices,
 # extensions TeX chargées à la demande (autoload), menu contextuel et accessibilité.
-MATHJAX_PARTS = ["tex-chtml.js", "output/chtml/fonts/woff-v2", "input/tex/extensions", "ui", "a11y", "adaptors"]
+MATHJAX_PARTS = ["tex-chtml.js", "output/chtml/fonts/woff-v2", "input/tex/extensions", "ui", "a11y", "adaptors",
+                 # composants chargés un à un par startup.js (_config.yml : mathjax_path, mathjax3_config)
+                 "startup.js", "core.js", "input/tex-base.js", "output/chtml.js", "output/chtml/fonts/tex.js"]
 
 
 def copy_tree(src: Path, dst: Path) -> None:

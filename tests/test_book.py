@@ -216,7 +216,7 @@ def test_chapter_pages_show_math_figures_and_glued_numbers(built_book, chapter):
 @pytest.mark.book
 def test_mermaid_diagrams_are_build_time_svg(built_book):
     html = (built_book / "book" / "predicteur-correcteur.html").read_text()
-    svgs = re.findall(r'<object data="(\.\./_images/mermaid-[0-9a-f]+\.svg)" type="image/svg\+xml">', html)
+    svgs = re.findall(r'<object data="(\.\./_images/mermaid-[0-9a-f]+\.svg)" type="image/svg\+xml"[^>]*>', html)
     assert len(svgs) == 3
     texts = [(built_book / "book" / s).resolve().read_text() for s in svgs]
     assert any("Kₙ₊₁" in t for t in texts)  # la boucle, indices lisibles

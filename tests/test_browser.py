@@ -1,10 +1,15 @@
 """Le site construit dans Chromium headless (Debian, /usr/bin/chromium), sans réseau.
 
 Le site est servi sur 127.0.0.1 (port libre) ; toute requête non locale est interceptée, bloquée et
-fait échouer le test. Pour chaque page : aucune erreur de page, formules typographiées par MathJax
-(servi par le site), diagrammes mermaid dessinés. Sur les pages à curseurs statiques : les curseurs
-sont déplacés par de vrais événements clavier et souris, et les données tracées, relues dans le
-document Bokeh, sont comparées aux exécutions calculées ici par le paquet.
+fait échouer le test. Pour chaque page : aucune erreur de page ni de console, formules typographiées
+par MathJax (servi par le site), diagrammes mermaid dessinés, aucune violation grave ou critique
+d'axe-core (règles WCAG 2.0/2.1 A et AA, le paquet npm de package-lock.json injecté dans la page,
+après le dessin des curseurs et des formules), au moins 2,5 Mo au premier chargement. Sur les pages à
+curseurs statiques : les curseurs sont déplacés par de vrais événements clavier et souris, et les
+données tracées, relues dans le document Bokeh, sont comparées aux exécutions calculées ici par le
+paquet. Un portable (1366 × 768) voit chaque panneau avec ses curseurs ; un téléphone (390 × 844, mode
+sombre) a des curseurs lisibles, des figures dans la colonne et des équations qui défilent ; le
+clavier atteint la première figure en quelques touches.
 
 Le français de chaque page est vérifié dans le texte courant (hors code, formules, adresses) : aucun
 TeX brut, aucun nombre à l'anglaise (« 0.5 », « 1e-05 »), une espace insécable devant « : ; ? ! » et
@@ -16,6 +21,7 @@ from __future__ import annotations
 
 import functools
 import http.server
+import os
 import re
 import threading
 from dataclasses import dataclass, field
@@ -68,12 +74,16 @@ class Site:
 
 
 @pytest.fixture(scope="module")
-def site(built_book):
-    handler = functools.partial(_QuietHandler, directory=str(built_book))
+def site(request):
+    """Le site construit par la session (``built_book``), ou un site déjà construit désigné par
+    ``KALMAN_BUILT_SITE`` (dossier html : pour relancer ces tests sans reconstruire)."""
+    wanted = os.environ.get("KALMAN_BUILT_SITE")
+    root = Path(wanted).resolve() if wanted else request.getfixturevalue("built_book")
+    handler = functools.partial(_QuietHandler, directory=str(root))
     server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
     thread = threading.Thread(target=server.serve_forever, daemon=True)
     thread.start()
-    yield Site(built_book, f"http://127.0.0.1:{server.server_address[1]}/")
+    yield Site(root, f"http://127.0.0.1:{server.server_address[1]}/")
     server.shutdown()
     server.server_close()
 
@@ -88,18 +98,37 @@ def browser():
         b.close()
 
 
+#: Tailles d'écran : un portable courant et un téléphone.
+LAPTOP = {"width": 1366, "height": 768}
+PHONE = {"width": 390, "height": 844}
+#: Le paquet npm axe-core (package-lock.json), injecté dans les pages.
+AXE = ROOT / "node_modules" / "axe-core" / "axe.min.js"
+#: Règles d'axe-core exigées : WCAG 2.0 et 2.1, niveaux A et AA (le RGAA).
+AXE_TAGS = ["wcag2a", "wcag2aa", "wcag21a", "wcag21aa"]
+#: Poids maximal d'une page au premier chargement (octets des fichiers servis).
+FIRST_LOAD_LIMIT = 2.5e6
+
+
 @dataclass
 class Visit:
     page: object
     blocked: list[str] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
+    console: list[str] = field(default_factory=list)
     broken: list[str] = field(default_factory=list)
     loaded: list[str] = field(default_factory=list)
+    first_load: list[str] = field(default_factory=list)
 
 
-def open_page(browser, url: str, allowed_prefix: str) -> Visit:
-    """Ouvre ``url`` en bloquant (et notant) toute requête qui ne commence pas par ``allowed_prefix``."""
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
+def open_page(browser, url: str, allowed_prefix: str, *, viewport=LAPTOP, color_scheme: str = "light",
+              figures: bool = True) -> Visit:
+    """Ouvre ``url`` en bloquant (et notant) toute requête qui ne commence pas par ``allowed_prefix``.
+
+    Après le chargement et la composition des formules, ``first_load`` note les adresses chargées (le
+    premier chargement) ; puis, si ``figures``, toutes les figures à curseurs de la page sont dessinées
+    (elles se chargent d'ordinaire quand elles approchent de l'écran).
+    """
+    context = browser.new_context(viewport=viewport, color_scheme=color_scheme)
     page = context.new_page()
     visit = Visit(page)
 
@@ -113,21 +142,56 @@ def open_page(browser, url: str, allowed_prefix: str) -> Visit:
 
     context.route("**/*", route)
     page.on("pageerror", lambda e: visit.errors.append(str(e)))
+    page.on("console", lambda m: visit.console.append(m.text) if m.type == "error" else None)
     page.on("response", lambda r: (visit.broken if r.status >= 400 else visit.loaded).append(r.url))
     page.on("requestfailed", lambda r: None if r.url in visit.blocked else visit.broken.append(r.url))
     page.goto(url, wait_until="load")
     # MathJax (chargé en « defer ») : attendre la fin de la composition initiale
     page.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise.then(() => true) : true")
-    n_fig = page.locator(f"[{MARKER}]").count()
-    if n_fig:
-        page.wait_for_function(
-            """(n) => window.Bokeh && Bokeh.documents.length >= n &&
-                 [...document.querySelectorAll('.kc-bokeh-root')].every(r => r.children.length > 0 &&
-                     !r.querySelector('.kc-bokeh-missing'))""",
-            arg=n_fig, timeout=15000,
-        )
-        page.locator(f"[{MARKER}] .noUi-handle").first.wait_for(timeout=15000)
+    visit.first_load = list(visit.loaded)
+    if figures:
+        load_figures(page)
     return visit
+
+
+def load_figures(page) -> None:
+    """Dessine toutes les figures à curseurs de la page et attend leurs curseurs."""
+    if not page.locator(f"[{MARKER}]").count():
+        return
+    page.evaluate("() => window.kcFigures.loadAll().then(() => true)")
+    page.wait_for_function(
+        """() => [...document.querySelectorAll('.kc-bokeh-root')].every(r => r.dataset.kcReady === '1' &&
+               !r.querySelector('.kc-bokeh-missing') && window.kcFigures.documents[r.id])""", timeout=20000)
+    page.locator(f"[{MARKER}] .noUi-handle").first.wait_for(timeout=15000)
+
+
+def figure_ids(page) -> list[str]:
+    """Les identifiants des figures à curseurs de la page, dans l'ordre."""
+    return page.evaluate("() => [...document.querySelectorAll('.kc-bokeh-root')].map(r => r.id)")
+
+
+def axe_violations(page) -> list[dict]:
+    """Les violations axe-core (WCAG A et AA) de la page : règle, impact, nombre de nœuds, exemples."""
+    page.evaluate(AXE.read_text())
+    return page.evaluate(
+        """(tags) => axe.run(document, {runOnly: {type: 'tag', values: tags}}).then(r => r.violations.map(v =>
+             ({id: v.id, impact: v.impact, nodes: v.nodes.length,
+               examples: v.nodes.slice(0, 3).map(n => n.target.join(' ') + ' : ' + n.html.slice(0, 120))})))""",
+        AXE_TAGS)
+
+
+def serious(violations: list[dict]) -> list[dict]:
+    return [v for v in violations if v["impact"] in ("serious", "critical")]
+
+
+def served_bytes(site, urls) -> int:
+    """Octets des fichiers du site servis pour ces adresses (chacune une fois)."""
+    total = 0
+    for url in dict.fromkeys(urls):
+        f = site.file_for(url)
+        if f.is_file():
+            total += f.stat().st_size
+    return total
 
 
 def html_pages(root: Path) -> list[Path]:
@@ -136,8 +200,9 @@ def html_pages(root: Path) -> list[Path]:
 
 
 def page_errors(visit: Visit, html: str) -> list[str]:
-    """Erreurs de page, plus un doublon de script en ligne (source connue d'erreur de redéclaration)."""
-    errors = list(visit.errors)
+    """Erreurs de page et de console, plus un doublon de script en ligne (source connue d'erreur de
+    redéclaration)."""
+    errors = list(visit.errors) + [f"console : {m}" for m in visit.console]
     if html.count("const THEBE_JS_URL") > 1:
         errors.append("script en ligne de sphinx-thebe présent plusieurs fois")
     return errors
@@ -206,10 +271,11 @@ def _mermaid_sources(html_file: Path, root: Path) -> int:
     return len(re.findall(r"^(?:```|:::)\{mermaid\}", source.read_text(), re.M))
 
 
-def test_every_page_is_offline_typeset_and_drawn(site, browser):
+def test_every_page_is_offline_typeset_and_drawn(site, browser, capsys):
     pages = html_pages(site.root)
     assert any(p.name == "tension-constante.html" for p in pages)
     problems: list[str] = []
+    report: list[str] = []
     for html_file in pages:
         html = html_file.read_text()
         name = html_file.relative_to(site.root).as_posix()
@@ -268,7 +334,22 @@ def test_every_page_is_offline_typeset_and_drawn(site, browser):
             problems.append(f"{name} : widget ipywidgets dans la page publiée")
         if page.locator("a[href*='executablebooks']").count():
             problems.append(f"{name} : lien vers le projet jupyter-book")
+        # léger : le premier chargement (avant qu'une figure n'approche) tient dans 2,5 Mo
+        first, full = served_bytes(site, visit.first_load), served_bytes(site, visit.loaded)
+        if first > FIRST_LOAD_LIMIT:
+            problems.append(f"{name} : {format_spec(first / 1e6, '.2f')} Mo au premier chargement (> 2,5 Mo)")
+        # RGAA : aucune violation grave ou critique d'axe-core, figures et formules dessinées
+        violations = axe_violations(page)
+        for v in serious(violations):
+            problems.append(f"{name} : axe-core « {v['id']} » ({v['impact']}, {v['nodes']} nœud(s)) {v['examples']}")
+        report.append(f"  {name:38s} {format_spec(first / 1e6, '.2f'):>5s} Mo au premier chargement, "
+                      f"{format_spec(full / 1e6, '.2f'):>5s} Mo figures comprises, "
+                      f"{format_spec(len(dict.fromkeys(visit.first_load)), 'd'):>3s} requêtes ; axe-core : "
+                      f"{format_spec(sum(v['nodes'] for v in serious(violations)), 'd')} nœud(s) grave(s), "
+                      f"{format_spec(sum(v['nodes'] for v in violations), 'd')} en tout")
         page.context.close()
+    with capsys.disabled():
+        print("\nPages (portable 1366 × 768, mode clair) :\n" + "\n".join(report))
     assert not problems, "\n".join(problems)
 
 
@@ -276,8 +357,8 @@ def test_every_page_is_offline_typeset_and_drawn(site, browser):
 
 # Toutes les sources tracées de la figure k (une par longueur de série : PLOTTED_SOURCE, PLOTTED_SOURCE-<L>),
 # la position de chaque curseur et le texte de lecture.
-_READ = """(k) => {
-  const doc = Bokeh.documents[k];
+_READ = """(id) => {
+  const doc = window.kcFigures.documents[id];
   const out = {};
   for (const m of doc.all_models) {
     if (m.name && m.name.startsWith('%s') && m.data) {
@@ -286,13 +367,13 @@ _READ = """(k) => {
   }
   const index = [];
   for (let s = 0; doc.get_model_by_name('kc-slider-' + s); s++) index.push(doc.get_model_by_name('kc-slider-' + s).value);
-  const readout = doc.get_model_by_name('kc-readout');
-  return {index: index, data: out, readout: readout ? readout.text : null};
+  const readout = document.getElementById(id + '-readout');
+  return {index: index, data: out, readout: readout ? readout.textContent : null};
 }""" % PLOTTED_SOURCE
 
 
-def _check_plotted(page, k: int, grid, root, name: str | None = None) -> tuple[int, ...]:
-    state = page.evaluate(_READ, k)
+def _check_plotted(page, fid: str, grid, root, name: str | None = None) -> tuple[int, ...]:
+    state = page.evaluate(_READ, fid)
     assert len(state["index"]) == len(grid.axes)
     assert all(float(v).is_integer() for v in state["index"])
     index = tuple(int(v) for v in state["index"])
@@ -300,10 +381,18 @@ def _check_plotted(page, k: int, grid, root, name: str | None = None) -> tuple[i
     for series, values in expected.items():
         np.testing.assert_allclose(np.array(state["data"][series], dtype=float), values, rtol=1e-12, atol=0,
                                    equal_nan=True, err_msg=f"série {series}, point {index}")
-    np.testing.assert_array_equal(state["data"]["t"], grid.time)
-    # les curseurs affichent les vraies valeurs du point de grille
+    if "t" in state["data"]:  # temps commun, s'il est tracé (des figures n'ont que des abscisses propres)
+        np.testing.assert_array_equal(state["data"]["t"], grid.time)
+    # les curseurs affichent les vraies valeurs du point de grille…
     shown = [root.locator(".bk-slider-value").nth(s).text_content() for s in range(len(grid.axes))]
-    assert shown == [french_spacing(axis.labels()[i]) for axis, i in zip(grid.axes, index)]
+    labels = [french_spacing(axis.labels()[i]) for axis, i in zip(grid.axes, index)]
+    assert shown == labels
+    # … et les annoncent aux lecteurs d'écran : nom français, valeur avec unité (pas l'indice)
+    page.wait_for_timeout(20)
+    for s, axis in enumerate(grid.axes):
+        handle = root.locator(".noUi-handle").nth(s)
+        assert handle.get_attribute("aria-label") == french_spacing(f"{axis.symbol} — {axis.description}")
+        assert handle.get_attribute("aria-valuetext") == labels[s]
     # le texte de lecture donne les nombres de cette exécution, calculés par le paquet
     if name is not None and ki.slider_spec(name).readout is not None:
         assert state["readout"] == french_spacing(ki.slider_spec(name).text_at(*index))
@@ -349,11 +438,13 @@ def test_static_sliders_show_the_package_runs(site, browser, capsys):
         visit = open_page(browser, site.url(html_file), site.base)
         page = visit.page
         figures = page.locator(f"[{MARKER}]")
-        for k in range(figures.count()):
-            fig_name = figures.nth(k).get_attribute(MARKER)
+        ids = figure_ids(page)
+        for j in range(figures.count()):
+            fig_name = figures.nth(j).get_attribute(MARKER)
+            root = figures.nth(j)
+            k = ids[j]  # la figure est relue par son identifiant
             assert fig_name in EXPECTED_GRIDS, f"figure « {fig_name} » inconnue du test : ajoutez sa grille"
             grid = EXPECTED_GRIDS[fig_name]()
-            root = figures.nth(k)
             check = functools.partial(_check_plotted, name=fig_name)
             # position par défaut = la figure statique du chapitre
             assert check(page, k, grid, root) == grid.default_index
@@ -414,10 +505,11 @@ def test_interactive_chapter_works_from_file_url(site, browser):
     assert page.locator("mjx-container").count() > 0
     grid = ki.voltage_grid()
     root = page.locator(f"[{MARKER}='tension-curseurs']")
-    assert _check_plotted(page, 0, grid, root) == grid.default_index
+    fid = figure_ids(page)[0]
+    assert _check_plotted(page, fid, grid, root) == grid.default_index
     root.locator(".noUi-handle").nth(1).focus()
     page.keyboard.press("PageUp")
-    i, j = _check_plotted(page, 0, grid, root)
+    i, j = _check_plotted(page, fid, grid, root)
     assert (i, j) != grid.default_index
     assert not page_errors(visit, html_file.read_text()), visit.errors
     page.context.close()
@@ -459,8 +551,8 @@ def _toc_pages(root: Path) -> list[Path]:
     return [root / f"{f}.html" for f in files if Path(f).name not in APPENDICES]
 
 
-def _plotted(page, k: int) -> dict:
-    return page.evaluate(_READ, k)["data"]
+def _plotted(page, fid: str) -> dict:
+    return page.evaluate(_READ, fid)["data"]
 
 
 def _differs(before: dict, after: dict) -> bool:
@@ -484,10 +576,12 @@ def test_every_chapter_has_a_slider_that_changes_the_plotted_data(site, browser)
             problems.append(f"{name} : aucune figure à curseurs")
             page.context.close()
             continue
-        for k in range(figures.count()):
-            fig_name = figures.nth(k).get_attribute(MARKER)
-            root = figures.nth(k)
+        ids = figure_ids(page)
+        for j in range(figures.count()):
+            fig_name = figures.nth(j).get_attribute(MARKER)
+            root = figures.nth(j)
             grid = EXPECTED_GRIDS[fig_name]()
+            k = ids[j]  # la figure est relue par son identifiant
             for s in range(len(grid.axes)):
                 before = _plotted(page, k)
                 handle = root.locator(".noUi-handle").nth(s)
@@ -546,3 +640,219 @@ def test_every_quiz_marks_a_right_and_a_wrong_answer(site, browser):
             problems.append(f"{name} : erreurs de page {visit.errors}")
         page.context.close()
     assert not problems, "\n".join(problems)
+
+
+# --------------------------------------------------------------------------- un écran, tout écran
+
+_PANELS_IN_VIEW = r"""(id) => {
+  // chaque panneau, amené en bas de l'écran : les curseurs (collés sous l'en-tête) et tout le panneau
+  // sont visibles ensemble
+  // (bas des en-têtes du thème encore à l'écran : l'en-tête du site défile, celui de l'article colle)
+  const controls = document.getElementById(id + '-controls');
+  const headerBottom = () => Math.max(0, ...[...document.querySelectorAll('.bd-header, .bd-header-article')]
+    .filter(h => getComputedStyle(h).display !== 'none').map(h => h.getBoundingClientRect().bottom));
+  const out = [];
+  for (const panel of document.getElementById(id).querySelectorAll('.kc-bokeh-panel')) {
+    panel.scrollIntoView({block: 'end'});
+    const top = headerBottom();
+    const p = panel.getBoundingClientRect(), c = controls.getBoundingClientRect();
+    out.push({panel: panel.id, height: Math.round(p.height), controls: Math.round(c.height),
+              ok: c.top >= top - 1 && c.bottom <= p.top + 1 && p.bottom <= window.innerHeight + 1 && p.height > 50});
+  }
+  const fig = document.getElementById(id).getBoundingClientRect();
+  return {panels: out, figure: Math.round(fig.height)};
+}"""
+
+
+def test_each_panel_and_its_sliders_fit_a_laptop_screen(site, browser, capsys):
+    """Sur un portable (1366 × 768), chaque panneau de chaque figure se voit en entier avec ses curseurs
+    (collés sous l'en-tête quand on fait défiler la figure) ; aucun panneau ne dépasse 700 px."""
+    problems, report = [], []
+    for html_file in _toc_pages(site.root):
+        name = html_file.relative_to(site.root).as_posix()
+        visit = open_page(browser, site.url(html_file), site.base)
+        page = visit.page
+        for fid in figure_ids(page):
+            found = page.evaluate(_PANELS_IN_VIEW, fid)
+            heights = [p["height"] for p in found["panels"]]
+            report.append(f"  {fid[3:-11]:30s} figure {format_spec(found['figure'], 'd'):>5s} px, curseurs "
+                          f"{format_spec(found['panels'][0]['controls'], 'd'):>4s} px, panneaux "
+                          f"{', '.join(format_spec(h, 'd') for h in heights)} px")
+            for p in found["panels"]:
+                if not p["ok"] or p["height"] > 700:
+                    problems.append(f"{name} : {p['panel']} ({p['height']} px) pas visible avec ses curseurs "
+                                    f"({p['controls']} px)")
+        page.context.close()
+    with capsys.disabled():
+        print("\nFigures sur un portable 1366 × 768 :\n" + "\n".join(report))
+    assert not problems, "\n".join(problems)
+
+
+_PHONE = r"""() => {
+  const out = {overflow: document.documentElement.scrollWidth - window.innerWidth, wide: [], overlap: [],
+               cut: [], values: []};
+  const column = document.querySelector('main .bd-article, main article, main');
+  const width = column ? column.getBoundingClientRect().width : window.innerWidth;
+  for (const el of document.querySelectorAll('main .kc-bokeh-panel, main .kc-bokeh-slider, main img, main object')) {
+    const b = el.getBoundingClientRect();
+    if (b.width > 0 && (b.right > window.innerWidth + 1 || b.left < -1)) out.wide.push(el.id || el.tagName);
+  }
+  for (const root of document.querySelectorAll('.kc-bokeh-root')) {
+    const boxes = [...root.querySelectorAll('.kc-bokeh-slider')].map(s => s.getBoundingClientRect());
+    for (let i = 0; i < boxes.length; i++) for (let j = i + 1; j < boxes.length; j++) {
+      const a = boxes[i], b = boxes[j];
+      if (a.left < b.right - 1 && b.left < a.right - 1 && a.top < b.bottom - 1 && b.top < a.bottom - 1)
+        out.overlap.push(root.id);
+    }
+  }
+  // une équation plus large que la colonne doit pouvoir défiler dans son cadre (pas de coupe)
+  for (const m of document.querySelectorAll("mjx-container[display='true']")) {
+    let box = m, scrolls = false;
+    for (let el = m; el && el !== document.body; el = el.parentElement) {
+      const style = getComputedStyle(el);
+      if (el.scrollWidth > el.clientWidth + 1 && (style.overflowX === 'auto' || style.overflowX === 'scroll')) {
+        scrolls = true; box = el; break;
+      }
+    }
+    const wide = m.scrollWidth > m.getBoundingClientRect().width + 1 ||
+                 m.getBoundingClientRect().right > window.innerWidth + 1;
+    if (wide && !scrolls) out.cut.push(m.textContent.slice(0, 40));
+  }
+  return out;
+}"""
+
+
+def test_phone_in_dark_mode_fits_the_column_and_passes_axe(site, browser, capsys):
+    """Sur un téléphone (390 × 844), en mode sombre : aucune page ne déborde de l'écran, les figures
+    tiennent dans la colonne, les curseurs ne se chevauchent pas et montrent leur valeur, chaque équation
+    trop large défile dans son cadre ; axe-core (contrastes du mode sombre compris) ne trouve aucune
+    violation grave ou critique, et la console reste vide."""
+    problems, report = [], []
+    for html_file in [p for p in html_pages(site.root) if "http-equiv" not in p.read_text()[:2000]]:
+        name = html_file.relative_to(site.root).as_posix()
+        visit = open_page(browser, site.url(html_file), site.base, viewport=PHONE, color_scheme="dark")
+        page = visit.page
+        assert page.evaluate("() => document.documentElement.dataset.theme") == "dark"
+        found = page.evaluate(_PHONE)
+        if found["overflow"] > 1:
+            problems.append(f"{name} : la page déborde de {found['overflow']} px à droite")
+        for key, label in (("wide", "hors de l'écran"), ("overlap", "curseurs qui se chevauchent"),
+                           ("cut", "équations coupées")):
+            if found[key]:
+                problems.append(f"{name} : {label} {found[key][:4]}")
+        for k, fid in enumerate(figure_ids(page)):
+            fig = page.locator(f"[{MARKER}]").nth(k)
+            grid = EXPECTED_GRIDS[fig.get_attribute(MARKER)]()
+            for s, axis in enumerate(grid.axes):  # chaque curseur montre sa valeur, entière et lisible
+                value = fig.locator(".bk-slider-value").nth(s)
+                box, slider = value.bounding_box(), page.locator(f"#{fid}-slider-{s}").bounding_box()
+                if value.text_content() != french_spacing(axis.labels()[axis.default]) or box is None or \
+                        box["x"] + box["width"] > slider["x"] + slider["width"] + 1:
+                    problems.append(f"{name} : valeur du curseur {s} de {fid} illisible")
+        violations = serious(axe_violations(page))
+        for v in violations:
+            problems.append(f"{name} : axe-core (mode sombre) « {v['id']} » ({v['nodes']}) {v['examples']}")
+        for err in page_errors(visit, html_file.read_text()):
+            problems.append(f"{name} : {err}")
+        report.append(f"  {name:38s} axe-core (sombre, téléphone) : "
+                      f"{format_spec(sum(v['nodes'] for v in violations), 'd')} nœud(s) grave(s)")
+        page.context.close()
+    with capsys.disabled():
+        print("\nPages sur un téléphone 390 × 844, mode sombre :\n" + "\n".join(report))
+    assert not problems, "\n".join(problems)
+
+
+# --------------------------------------------------------------------------- clavier et lecteur d'écran
+
+_FOCUSED = r"""() => {
+  let el = document.activeElement;
+  while (el && el.shadowRoot && el.shadowRoot.activeElement) el = el.shadowRoot.activeElement;
+  return el ? {tag: el.tagName.toLowerCase(), cls: String(el.className || ''), label: el.getAttribute('aria-label'),
+               text: (el.textContent || '').trim().slice(0, 40)} : null;
+}"""
+
+
+def _tabs_to_slider(page, limit: int = 200) -> int:
+    for n in range(1, limit + 1):
+        page.keyboard.press("Tab")
+        focused = page.evaluate(_FOCUSED)
+        if focused and "noUi-handle" in focused["cls"]:
+            return n
+    return limit + 1
+
+
+def test_keyboard_reaches_the_first_slider_in_a_few_keys(site, browser, capsys):
+    """Au clavier, depuis le haut de l'introduction : les formules ne sont plus des arrêts de tabulation,
+    le lien « Aller à la figure à curseurs » (deuxième arrêt) mène au premier curseur en quatre touches,
+    et le curseur s'annonce par son nom français et sa valeur avec unité."""
+    url = site.url(site.root / "book" / "intro.html")
+    visit = open_page(browser, url, site.base)
+    page = visit.page
+    assert page.evaluate("() => document.querySelectorAll('mjx-container[tabindex=\"0\"]').length") == 0
+    assert page.locator("mjx-assistive-mml").count() > 0  # la MathML d'assistance reste
+    page.evaluate("() => { document.activeElement && document.activeElement.blur(); window.scrollTo(0, 0); }")
+    plain = _tabs_to_slider(page)
+    page.context.close()
+
+    visit = open_page(browser, url, site.base, figures=False)
+    page = visit.page
+    page.keyboard.press("Tab")
+    page.keyboard.press("Tab")
+    focused = page.evaluate(_FOCUSED)
+    assert focused["text"] == "Aller à la figure à curseurs", focused
+    page.keyboard.press("Enter")
+    page.wait_for_function("() => document.querySelector('.kc-bokeh-root').dataset.kcReady === '1'", timeout=20000)
+    page.keyboard.press("Tab")
+    focused = page.evaluate(_FOCUSED)
+    assert "noUi-handle" in focused["cls"], focused
+    spec = ki.slider_spec(page.locator(f"[{MARKER}]").first.get_attribute(MARKER))
+    axis = spec.grid().axes[0]
+    assert focused["label"] == french_spacing(f"{axis.symbol} — {axis.description}")
+    handle = page.locator(".noUi-handle").first
+    assert handle.get_attribute("aria-valuetext") == french_spacing(axis.labels()[axis.default])
+    page.keyboard.press("ArrowRight")
+    page.wait_for_timeout(50)
+    assert handle.get_attribute("aria-valuetext") == french_spacing(axis.labels()[axis.default + 1])
+    page.context.close()
+    with capsys.disabled():
+        print(f"\nClavier (introduction) : premier curseur atteint en {plain} tabulations depuis le haut de la "
+              "page, ou en 4 touches par le lien d'évitement (Tab, Tab, Entrée, Tab)")
+    assert plain <= 60, f"{plain} tabulations avant le premier curseur"
+
+
+def test_diagrams_and_quiz_answers_have_text_alternatives(site, browser):
+    """Les diagrammes ont un texte de remplacement (les textes de leurs boîtes) ; chaque réponse de quiz
+    a un nom accessible lisible, formules écrites en texte."""
+    html_file = site.root / "book" / "predicteur-correcteur.html"
+    visit = open_page(browser, site.url(html_file), site.base, figures=False)
+    page = visit.page
+    labels = page.evaluate("() => [...document.querySelectorAll('object[type=\"image/svg+xml\"]')].map(o => "
+                           "[o.getAttribute('role'), o.getAttribute('aria-label')])")
+    assert len(labels) == 3
+    for role, label in labels:
+        assert role == "img" and label.startswith("Diagramme : ") and len(label) > 40, label
+    names = page.evaluate("() => [...document.querySelectorAll('.kc-quiz input[type=radio]')].map(r => "
+                          "r.getAttribute('aria-label'))")
+    assert names and all(re.fullmatch(r"Réponse [a-e] : .+", n) for n in names), names
+    assert not any("\\" in n or "{" in n for n in names), names  # pas de TeX brut
+    page.context.close()
+
+
+# --------------------------------------------------------------------------- recherche
+
+
+def test_search_shows_readable_snippets(site, browser):
+    """La recherche du site trouve « innovation » dans le chapitre qui la définit, et ses extraits
+    montrent les formules en texte lisible, sans TeX brut."""
+    visit = open_page(browser, site.base + "search.html?q=innovation", site.base, figures=False)
+    page = visit.page
+    page.wait_for_function("() => document.querySelectorAll('#search-results li').length > 0", timeout=30000)
+    page.wait_for_timeout(1500)  # les extraits arrivent page par page
+    results = page.evaluate("""() => [...document.querySelectorAll('#search-results li')].map(li => ({
+        href: li.querySelector('a').getAttribute('href'), text: li.textContent}))""")
+    hrefs = [r["href"] for r in results]
+    assert any("predicteur-correcteur" in h for h in hrefs[:3]), hrefs[:5]
+    for r in results:
+        assert not re.search(r"\\\(|\\\)|\\\[|\\[a-zA-Z]{2,}", r["text"]), r["text"][:200]
+    assert not page_errors(visit, "")
+    page.context.close()

@@ -129,8 +129,8 @@ def test_page_shows_its_slider_figures_each_with_an_observation_box_and_live_cod
     assert shown, f"{page} : aucune figure à curseurs"
     assert sorted(shown) == sorted(ki.slider_names(page)), f"{page} : figures du registre non montrées"
     for name in shown:
-        call = f'sliders("{name}")' if name not in _LEGACY.values() else \
-            {v: f"{k}_sliders()" for k, v in _LEGACY.items()}[name]
+        legacy = {v: f"{k}_sliders()" for k, v in _LEGACY.items()}
+        call = next(c for c in (f'sliders("{name}")', legacy.get(name, "\0")) if c in text)
         after = text[text.index(call):]
         box = re.search(r"(:{3,4})\{admonition\} À observer\n:class: \w+\n(.*?)\n\1\n", after, re.S)
         assert box and after.index(box.group(0)) < 400, f"{page} : pas d'encadré « À observer » après {name}"

@@ -202,7 +202,7 @@ def test_static_figure_html_carries_the_exact_grid(vgrid):
     assert f'{MARKER}="tension-curseurs"' in html
     # BokehJS vient du site, pas de la figure : ni script externe ni adresse réseau
     assert "<script src" not in html and re.search(r"https?://", html) is None
-    item = re.search(r'<script type="application/json" id="[^"]+">(.*?)</script>', html, re.S)[1]
+    item = re.search(r'<script type="application/json" id="[^"]+-item">(.*?)</script>', html, re.S)[1]
     doc = json.loads(item)
     arrays = []
     _decode_bokeh_arrays(doc, arrays)

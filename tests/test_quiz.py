@@ -45,7 +45,7 @@ Deuxième question ?
 - un
 - deux
 - trois
-- quatre
+- $K = P^-/(P^- + R)$
 :::
 ::::
 
@@ -89,8 +89,11 @@ def test_html_quiz_has_radios_answers_and_one_script(tmp_path):
     assert 'data-name="gain-r"' in html
     # trois puis quatre boutons radio, groupés par question, valeurs 1…n
     for qid, n in (("kc-quiz-index-1", 3), ("kc-quiz-index-2", 4)):
-        values = re.findall(rf'<input type="radio" name="{qid}" value="(\d)">', html)
-        assert values == [str(k) for k in range(1, n + 1)]
+        values = re.findall(rf'<input type="radio" name="{qid}" value="(\d)" aria-label="Réponse ([a-z]) : [^"]+">',
+                            html)
+        assert values == [(str(k), "abcd"[k - 1]) for k in range(1, n + 1)]
+    # une réponse faite d'une formule a un nom accessible lisible (pas de TeX brut)
+    assert 'aria-label="Réponse d : K = P⁻/(P⁻ + R)"' in html
     assert html.count("Vérifier</button>") == 2
     # l'explication existe pour la première question seulement (la seconde n'en a pas)
     assert html.count('class="kc-quiz-explanation" hidden') == 1

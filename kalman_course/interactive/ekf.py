@@ -15,7 +15,7 @@ import numpy as np
 from ..scenarios.polar import POLAR_BEARING_STD_DEG, POLAR_MEAN, POLAR_RANGE_STD, polar_transform
 from .figure import SliderSpec, ellipse_outline, number, register_sliders
 from .grid import ParameterAxis
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["BEARING_STDS", "RANGE_STDS", "SHOWN", "polar_axes", "ekf_run", "ekf_spec"]
 
@@ -26,8 +26,9 @@ RANGE_STDS = (0.125, 0.25, 0.5, 1.0, 2.0)
 #: Nombre de tirages affichés (les moments sont calculés sur tous).
 SHOWN = 400
 #: Azimuts (degrés) du panneau de la tangente.
-ANGLES = np.linspace(-90.0, 90.0, 121)
-_PLANE = dict(x_label="x (m)", x_range=(-6.0, 13.0), y_range=(-11.0, 11.0), equal_aspect=True, width=480)
+ANGLES = np.linspace(-180.0, 180.0, 241)  # ±2σθ atteint ±120° à σθ = 60°
+# le plan suit les tracés de l'exécution affichée (un croissant de 2 m à 2,5°, de 40 m à 60°), cadre carré
+_PLANE = dict(x_label="x (m)", x_range=(-6.0, 13.0), y_range=Follow(aspect=1.0, margin=0.06), equal_aspect=True)
 
 
 def polar_axes() -> tuple[ParameterAxis, ParameterAxis]:
@@ -59,7 +60,7 @@ def ekf_run(bearing_std_deg: float, range_std: float) -> dict[str, np.ndarray]:
     out = _common(tr)
     a = 2.0 * bearing_std_deg
     out["band_x"] = np.array([-a, -a, np.nan, a, a])
-    out["band_y"] = np.array([0.0, 11.0, np.nan, 0.0, 11.0])
+    out["band_y"] = np.array([-11.0, 11.0, np.nan, -11.0, 11.0])
     out["mean_line"] = np.repeat(tr.exact_mean[0], ANGLES.size)
     return out
 
@@ -106,8 +107,8 @@ def ekf_spec() -> SliderSpec:
                     Glyph("band_y", "line", "royalblue", "± 2 σθ", x="band_x", dash="dotted"),
                 ),
                 x_label="azimut θ (°)",
-                x_range=(-90.0, 90.0),
-                y_range=(0.0, 11.0),
+                x_range=(-180.0, 180.0),
+                y_range=(-11.0, 11.0),
                 height=220,
             ),
         ),

@@ -15,7 +15,7 @@ import numpy as np
 from ..scenarios.convergence import LINEAR_STEPS, ensemble_spread
 from .figure import SliderSpec, number, register_sliders
 from .grid import ParameterAxis
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["MEMBERS", "ensemble_axes", "ensemble_run", "ensemble_spec"]
 
@@ -74,7 +74,7 @@ def ensemble_spec() -> SliderSpec:
                     Glyph("ensemble", "line", "darkorange", "ensemble de l'EnKF"),
                     Glyph("ensemble", "scatter", "darkorange", "", marker="circle", size=4),
                 ),
-                y_range=(0.0, 1.2),
+                y_range=Follow(columns=("ensemble", "kalman"), include=(0.0,)),
                 height=280,
             ),
         ),

@@ -13,7 +13,7 @@ import numpy as np
 from ..scenarios.stability import COUNTER_A, COUNTER_C, STABILITY_RUNS, STABILITY_STEPS, fixed_gain_experiment
 from .figure import SliderSpec, number, register_sliders
 from .grid import ParameterAxis
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["GAINS", "CURVE_GAINS", "SYSTEMS", "estimator_axes", "estimator_run", "estimator_spec"]
 
@@ -85,10 +85,12 @@ def estimator_spec() -> SliderSpec:
                     Glyph("recursion", "line", "royalblue", "récurrence du cours"),
                     Glyph("monte_carlo", "scatter", "black", f"moyenne de {STABILITY_RUNS} simulations",
                           marker="circle", size=5),
+                    Glyph("", "hline", "gray", "plancher 10⁻⁸ : erreur nulle", value=FLOOR, dash="dotted", width=1.0),
                 ),
                 y_log=True,
-                y_range=(FLOOR, 1e10),
-                height=260,
+                # le plancher reste une décade au-dessus du bas de l'axe ; le haut suit l'erreur affichée
+                y_range=Follow(columns=("recursion", "monte_carlo"), include=(FLOOR / 10.0, 10.0)),
+                height=240,
             ),
             Panel(
                 "Stabilité : c'est |(1 − KC)A| qui doit être < 1, pas |1 − KC|",
@@ -103,7 +105,7 @@ def estimator_spec() -> SliderSpec:
                 x_label="gain K (sans unité)",
                 x_range=(-0.05, 2.05),
                 y_range=(0.0, 3.2),
-                height=230,
+                height=200,
             ),
         ),
         fixed={"gains": CURVE_GAINS, "printed_curve": np.abs(1.0 - CURVE_GAINS * COUNTER_C)},

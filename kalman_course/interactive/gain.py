@@ -13,7 +13,7 @@ import numpy as np
 from ..scenarios.gain_trace import gain_trace
 from .figure import SliderSpec, number, register_sliders, subscript
 from .grid import ParameterAxis
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["STEPS", "CURVE_K", "gain_axes", "gain_run", "gain_spec"]
 
@@ -92,8 +92,9 @@ def gain_spec() -> SliderSpec:
                 ),
                 x_label="gain K (sans unité)",
                 x_range=(0.0, 1.0),
-                y_range=(0.0, 1.6),
-                height=330,
+                # l'axe suit le point choisi (Pₙ(1)/P⁻ₙ = Ψ/P⁻ₙ ≈ 19 à n = 50) ; les courbes peuvent en sortir
+                y_range=Follow(columns=("prediction", "ratio_star", "ratio_now"), include=(0.0, 1.05)),
+                height=300,
             ),
         ),
         readout=_readout,

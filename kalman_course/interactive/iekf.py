@@ -96,7 +96,8 @@ def iekf_spec() -> SliderSpec:
                 "Les itérés x⁽ⁱ⁾ dans le plan",
                 "y (m)",
                 (
-                    Glyph("prior_y", "line", "darkorange", "a priori x̂⁻, 1σ", x="prior_x", dash="dashed"),
+                    Glyph("prior_y", "line", "darkorange", "a priori x̂⁻, 1σ", x="prior_x", dash="dashed",
+                          clip=True),  # l'ellipse de σ₀ = 30 m déborde du détail
                     Glyph("path_y", "line", "royalblue", "itérés de Gauss–Newton", x="path_x"),
                     Glyph("path_y", "scatter", "royalblue", "", x="path_x", marker="circle", size=6),
                     Glyph("ekf_y", "scatter", "firebrick", "EKF = x⁽¹⁾", x="ekf_x", marker="square", size=12,
@@ -109,7 +110,6 @@ def iekf_spec() -> SliderSpec:
                 x_range=(7.0, 10.6),
                 y_range=(-0.5, 3.9),
                 equal_aspect=True,
-                width=480,
             ),
             Panel(
                 "Distance au MAP à chaque itération",

@@ -18,7 +18,7 @@ import numpy as np
 from ..scenarios import intuition as sc
 from .figure import SliderSpec, number, register_sliders, subscript
 from .grid import ParameterAxis, log_grid
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["product_spec", "cycle_spec", "CYCLE_POSITIONS", "GAIN_CURVE_P"]
 
@@ -35,8 +35,10 @@ _EVERY = 5
 
 
 #: Variances proposées (m²) pour :math:`P^-` et :math:`R` : des puissances de 2, pour que les deux curseurs
-#: puissent prendre la même valeur ; l'exemple du chapitre est :math:`P^- = 4`, :math:`R = 1`.
-VARIANCES = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0)
+#: puissent prendre la même valeur ; l'exemple du chapitre est :math:`P^- = 4`, :math:`R = 1`. Aux bouts,
+#: un rapport 64 entre les deux variances : le gain va de 0,06 à 0,98 (« la mesure ne déplace presque
+#: plus l'estimation », « on ne croit plus que la mesure »).
+VARIANCES = (0.0625, 0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0)
 
 
 def product_axes() -> tuple[ParameterAxis, ParameterAxis]:
@@ -58,7 +60,7 @@ def _gain_curve(meas_var: float) -> np.ndarray:
 def product_run(prior_var: float, meas_var: float) -> dict[str, np.ndarray]:
     """Une exécution : densités (1/m) sur :data:`PRODUCT_POSITIONS`, repères verticaux, courbe du gain."""
     out = sc.product_experiment(prior_var, meas_var, positions=PRODUCT_POSITIONS)
-    peak = 1.1 * max(out["prior"].max(), out["likelihood"].max(), out["posterior"].max())
+    peak = max(out["prior"].max(), out["likelihood"].max(), out["posterior"].max())
     gains = _gain_curve(float(meas_var))
     return {
         "prior": out["prior"],
@@ -110,10 +112,11 @@ def product_spec() -> SliderSpec:
                           marker="circle", size=4),
                     Glyph("mark_y", "line", "royalblue", "", x="mark_x", dash="dashed", width=1.5),
                 ),
-                height=300,
+                height=270,
                 x_label="position du chariot x (m)",
                 x_range=(0.0, 25.0),
-                y_range=(0.0, 1.0),
+                # l'axe suit les densités : un pic de 1,6 /m (R = 1/16 m²) comme une loi étalée
+                y_range=Follow(columns=("prior", "likelihood", "posterior"), include=(0.0,)),
             ),
             Panel(
                 "Le gain K, poids de la mesure, en fonction de P⁻ (pour le R choisi)",
@@ -123,7 +126,7 @@ def product_spec() -> SliderSpec:
                     Glyph("K", "scatter", "crimson", "position des curseurs", x="P_now", marker="circle", size=10),
                     Glyph("", "hline", "gray", "", value=0.5, dash="dotted", width=1.0),
                 ),
-                height=220,
+                height=200,
                 x_label="variance a priori P⁻ (m²)",
                 x_range=(float(GAIN_CURVE_P[0]), float(GAIN_CURVE_P[-1])),
                 y_range=(0.0, 1.05),

@@ -19,7 +19,7 @@ from ..likelihood import log_likelihood
 from ..scenarios.nile import local_level_model, nile_fit, nile_run
 from .figure import SliderSpec, number, register_sliders
 from .smoothing import nile_axes
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["PROFILE_Q", "likelihood_axes", "likelihood_run", "likelihood_spec"]
 
@@ -92,8 +92,10 @@ def likelihood_spec() -> SliderSpec:
                 x_label="Q = σ²η ((10⁸ m³ par an)²)",
                 x_range=(float(PROFILE_Q[0]), float(PROFILE_Q[-1])),
                 x_log=True,
-                y_range=(float(fit.log_likelihood) - 40.0, float(fit.log_likelihood) + 3.0),
-                height=260,
+                # l'axe montre toujours le point choisi et le maximum (40 nats sous le maximum au moins)
+                y_range=Follow(columns=("ll_now", "ll_hat"),
+                               include=(float(fit.log_likelihood) - 40.0, float(fit.log_likelihood) + 3.0)),
+                height=240,
             ),
             Panel(
                 "Innovations normalisées du filtre (initialisation diffuse exacte)",
@@ -103,8 +105,8 @@ def likelihood_spec() -> SliderSpec:
                     Glyph("", "hline", "gray", "", value=-2.0, dash="dashed", width=1.0),
                     Glyph("normalised", "line", "darkorange", "innovation normalisée", width=1.2),
                 ),
-                y_range=(-6.0, 6.0),
-                height=230,
+                y_range=Follow(columns=("normalised",), include=(-3.0, 3.0)),  # ± 2 toujours visibles
+                height=200,
             ),
         ),
         fixed={"profile_q": PROFILE_Q, "Q_hat": np.array([Q_hat]), "ll_hat": np.array([fit.log_likelihood])},

@@ -22,7 +22,7 @@ import numpy as np
 from ..core.validation import KalmanInputError, as_float_array
 from ..numbers import format_spec
 from .grid import format_value
-from .spec import Panel, check_columns, draw_panels, fill_glyph
+from .spec import Panel, check_columns, draw_panels, fill_glyph, panel_y_range
 
 __all__ = ["LogParameter", "LinearParameter", "ChoiceParameter", "LiveExplorer"]
 
@@ -267,7 +267,9 @@ class LiveExplorer:
             fills.append((ax, glyph, fill_glyph(ax, glyph, data)))
         self._fills = fills
         for ax, panel in zip(self._axes, self.panels):
-            if panel.y_range is None:
+            if panel.follows:
+                ax.set_ylim(*panel_y_range(panel, data))
+            elif panel.y_range is None:
                 ax.relim()
                 ax.autoscale_view(scalex=False)
         self.image.value = self._png()

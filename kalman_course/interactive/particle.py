@@ -19,9 +19,10 @@ from ..numbers import format_integer
 from ..filters.particle import particle_filter
 from ..scenarios.convergence import LINEAR_STEPS, linear_benchmark
 from .grid import ParameterAxis, ParameterGrid, precompute_grid
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
-__all__ = ["PF_SEED", "particle_axes", "particle_run", "particle_grid", "particle_panels", "particle_sliders"]
+__all__ = ["PF_SEED", "particle_axes", "particle_run", "particle_grid", "particle_panels", "particle_readout",
+           "particle_sliders"]
 
 #: Graine du filtre particulaire (la même pour toutes les positions des curseurs).
 PF_SEED = 1
@@ -74,20 +75,32 @@ def particle_panels() -> tuple[Panel, ...]:
                 Glyph("hi", "line", "lightsteelblue", "+ 2σ"),
                 Glyph("gap", "line", "darkorange", "filtre particulaire − filtre de Kalman"),
             ),
-            height=260,
-            y_range=(-4.0, 4.0),
+            height=240,
+            # l'axe suit la bande ±2σ du R choisi (elle ne dépend pas de N) : à R = 0,01 m², ±0,2 m,
+            # et l'écart de N = 1 000 à N = 10 000 se voit ; l'estimation peut sortir de l'axe (N = 10)
+            y_range=Follow(columns=("lo", "hi"), margin=0.3),
         ),
         Panel("Taille effective de l'échantillon après chaque mesure", "ESS / N (sans unité)",
-              (Glyph("ess", "line", "darkorange", "ESS / N"),), y_log=True, y_range=(1e-3, 1.0)),
+              (Glyph("ess", "line", "darkorange", "ESS / N"),), y_log=True, y_range=(1e-3, 1.0), height=190),
     )
+
+
+def particle_readout(series, values) -> str:
+    """Le texte sous les curseurs : écart maximal au filtre de Kalman, demi-largeur de la bande, ESS."""
+    from .figure import number
+
+    N = values[0]
+    gap = float(np.max(np.abs(series["gap"])))
+    band = float(np.max(series["hi"]))
+    ess = float(np.median(series["ess"]))
+    return (f"Écart maximal au filtre de Kalman : {number(gap, 'm')} (bande ±2σ : ±{number(band, 'm')}). "
+            f"Taille effective médiane après une mesure : ESS/N = {number(ess)}, soit "
+            f"{format_integer(round(ess * N))} particules utiles sur {format_integer(N)}.")
 
 
 def particle_sliders():
-    """Figure à curseurs statiques :math:`N` et :math:`R` (Bokeh)."""
-    from .static import StaticSliders
+    """Figure à curseurs statiques :math:`N` et :math:`R` (Bokeh) : celle du registre,
+    ``kc.interactive.sliders("filtre-particulaire-curseurs")``."""
+    from .figure import sliders
 
-    return StaticSliders(
-        particle_grid(), particle_panels(), x_label="pas de temps k",
-        name="filtre-particulaire-curseurs",
-        title="Filtre particulaire : nombre de particules N et variance de mesure R",
-    )
+    return sliders("filtre-particulaire-curseurs")

@@ -15,7 +15,7 @@ from ..scenarios.engine import ENGINE_DT
 from ..scenarios.sensor_tuning import SENSOR_STD, TUNING_STEPS, sensor_tuning
 from .figure import SliderSpec, number, register_sliders
 from .grid import ParameterAxis, log_grid
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["practice_axes", "practice_run", "practice_spec"]
 
@@ -73,8 +73,8 @@ def practice_spec() -> SliderSpec:
                     Glyph("normalised", "line", "royalblue", "innovation normalisée", width=1.0),
                     Glyph("normalised", "scatter", "royalblue", "", marker="dot", size=6),
                 ),
-                y_range=(-8.0, 8.0),
-                height=250,
+                y_range=Follow(columns=("normalised",), include=(-3.0, 3.0)),  # ± 2 toujours visibles
+                height=220,
             ),
             Panel(
                 "Ce que l'on ne voit pas : l'erreur sur θₘ et l'écart-type annoncé",
@@ -83,8 +83,9 @@ def practice_spec() -> SliderSpec:
                     Glyph("lower", "band", "royalblue", "± 2 √Pₙ,₁₁ annoncé par le filtre", upper="upper"),
                     Glyph("error", "line", "firebrick", "erreur vraie", width=1.2),
                 ),
-                y_range=(-4.0, 4.0),
-                height=250,
+                # l'axe suit l'erreur : la bande (très large au départ) peut en sortir
+                y_range=Follow(columns=("error",), margin=0.4),
+                height=220,
             ),
         ),
         readout=_readout,

@@ -16,9 +16,9 @@ from ..scenarios.engine_cycle import CYCLE_STEPS, engine_cycle
 from ..scenarios.intuition import gaussian_density
 from .figure import SliderSpec, number, register_sliders, subscript
 from .grid import ParameterAxis
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
-__all__ = ["PSI_SCALES", "THETA", "predictor_axes", "predictor_run", "predictor_spec"]
+__all__ = ["PSI_SCALES", "THETA", "density_positions", "predictor_axes", "predictor_run", "predictor_spec"]
 
 CHAPTER = "predicteur-correcteur"
 
@@ -26,6 +26,8 @@ CHAPTER = "predicteur-correcteur"
 PSI_SCALES = (1e-6, 1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6)
 #: Échauffements du moteur (°C) où la densité de :math:`\theta_m` est tracée.
 THETA = np.round(np.arange(-5.0, 25.0001, 0.15), 10)
+#: Points ajoutés autour de la moyenne de chaque densité tracée (:func:`density_positions`).
+PEAK_POINTS = 41
 
 
 def stage_labels(n_steps: int = CYCLE_STEPS) -> tuple[str, ...]:
@@ -47,6 +49,15 @@ def predictor_axes() -> tuple[ParameterAxis, ParameterAxis]:
     )
 
 
+def density_positions(mean: float, var: float) -> np.ndarray:
+    """Les abscisses (°C) où une densité :math:`\\mathcal N(m, v)` est tracée : :data:`THETA`, plus
+    :data:`PEAK_POINTS` points entre :math:`m \\pm 4\\sqrt v` (dans la fenêtre), pour qu'un pic plus étroit
+    que le pas de :data:`THETA` (un filtre qui croit les mesures parfaites) soit dessiné. Forme
+    ``(THETA.size + PEAK_POINTS,)``, croissante."""
+    extra = np.clip(mean + np.sqrt(var) * np.linspace(-4.0, 4.0, PEAK_POINTS), THETA[0], THETA[-1])
+    return np.sort(np.concatenate([THETA, extra]))
+
+
 def predictor_run(stage: float, psi_scale: float) -> dict[str, np.ndarray]:
     """La loi de :math:`\\theta_m` à l'étape choisie et à la précédente ; l'écart-type à chaque étape."""
     cycle = engine_cycle(psi_scale)
@@ -55,9 +66,20 @@ def predictor_run(stage: float, psi_scale: float) -> dict[str, np.ndarray]:
     n = steps.step_of(k)
     mean, var = steps.mean[:, 0], steps.cov[:, 0, 0]
     nan2 = np.full(2, np.nan)
+    current_x = density_positions(mean[k], var[k])
+    current = gaussian_density(current_x, mean[k], var[k])
+    if k > 0:
+        previous_x = density_positions(mean[k - 1], var[k - 1])
+        previous = gaussian_density(previous_x, mean[k - 1], var[k - 1])
+    else:
+        previous_x = previous = np.full(current_x.size, np.nan)
+    top = 1.05 * np.nanmax(np.concatenate([current, previous]))
     return {
-        "current": gaussian_density(THETA, mean[k], var[k]),
-        "previous": gaussian_density(THETA, mean[k - 1], var[k - 1]) if k > 0 else np.full(THETA.size, np.nan),
+        "current_x": current_x,
+        "current": current,
+        "previous_x": previous_x,
+        "previous": previous,
+        "bar_y": np.array([0.0, top]),
         "truth_x": np.repeat(cycle.simulation.x[n - 1, 0], 2) if n > 0 else nan2,
         "inverted_x": np.repeat(cycle.inverted[n - 1, 0], 2) if steps.kind[k] == "correction" else nan2,
         "std": np.sqrt(var),
@@ -105,15 +127,17 @@ def predictor_spec() -> SliderSpec:
                 "Loi de l'échauffement du moteur θₘ à l'étape choisie",
                 "densité de probabilité (1/°C)",
                 (
-                    Glyph("previous", "line", "gray", "étape précédente", dash="dashed", width=1.5),
-                    Glyph("current", "area", "royalblue", "étape choisie"),
-                    Glyph("current", "line", "royalblue", ""),
+                    Glyph("previous", "line", "gray", "étape précédente", x="previous_x", dash="dashed",
+                          width=1.5),
+                    Glyph("current", "area", "royalblue", "étape choisie", x="current_x"),
+                    Glyph("current", "line", "royalblue", "", x="current_x"),
                     Glyph("bar_y", "line", "black", "valeur vraie θₘ", x="truth_x", dash="dotted"),
                     Glyph("bar_y", "line", "seagreen", "mesure inversée (C⁻¹yₙ)₁", x="inverted_x"),
                 ),
                 x_label="échauffement du moteur θₘ (°C)",
                 x_range=(float(THETA[0]), float(THETA[-1])),
-                y_range=(0.0, 1.0),
+                # l'axe suit la densité affichée : un pic de 800 /°C (s = 10⁻⁶) comme une loi presque plate
+                y_range=Follow(columns=("current", "previous"), include=(0.0,)),
                 height=270,
             ),
             Panel(
@@ -131,6 +155,6 @@ def predictor_spec() -> SliderSpec:
                 height=220,
             ),
         ),
-        fixed={"stages": stages, "bar_y": np.array([0.0, 1.0])},
+        fixed={"stages": stages},
         readout=_readout,
     )

@@ -15,15 +15,17 @@ from ..datasets.nile import nile
 from ..scenarios import banana
 from ..scenarios.convergence import LINEAR_STEPS
 from .figure import SliderSpec, register_sliders
-from .particle import particle_axes, particle_panels, particle_run
-from .smoothing import nile_axes, nile_panels, nile_slider_run
+from .particle import particle_axes, particle_panels, particle_readout, particle_run
+from .smoothing import nile_axes, nile_panels, nile_readout, nile_slider_run
 from .unscented import (
     N_POINTS,
     banana_parameter_axes,
     banana_parameter_panels,
+    banana_parameter_readout,
     banana_parameter_run,
     banana_uncertainty_axes,
     banana_uncertainty_panels,
+    banana_uncertainty_readout,
     banana_uncertainty_run,
 )
 
@@ -38,6 +40,7 @@ def banana_uncertainty_spec() -> SliderSpec:
         title="La banane (r = 1 m, θ = 90°) : déplacez les incertitudes d'azimut et de distance",
         x_label="x (m)", axes=banana_uncertainty_axes(), run=banana_uncertainty_run,
         time=np.arange(N_POINTS, dtype=float), panels=banana_uncertainty_panels(),
+        readout=banana_uncertainty_readout,
     )
 
 
@@ -50,7 +53,7 @@ def banana_parameter_spec() -> SliderSpec:
         title="Les paramètres des points sigma : α et κ (σθ = 20°, σᵣ = 2 cm)",
         x_label="x (m)", axes=banana_parameter_axes(), run=banana_parameter_run,
         time=np.arange(N_POINTS, dtype=float), panels=banana_parameter_panels(),
-        fixed={"cloud_x": sample[:, 0], "cloud_y": sample[:, 1]},
+        fixed={"cloud_x": sample[:, 0], "cloud_y": sample[:, 1]}, readout=banana_parameter_readout,
     )
 
 
@@ -61,7 +64,7 @@ def particle_spec() -> SliderSpec:
         name="filtre-particulaire-curseurs", chapter="filtre-particulaire",
         title="Filtre particulaire : nombre de particules N et variance de mesure R",
         x_label="pas de temps k", axes=particle_axes(), run=particle_run,
-        time=np.arange(1, LINEAR_STEPS + 1, dtype=float), panels=particle_panels(),
+        time=np.arange(1, LINEAR_STEPS + 1, dtype=float), panels=particle_panels(), readout=particle_readout,
     )
 
 
@@ -73,4 +76,5 @@ def nile_spec() -> SliderSpec:
         title="Le Nil filtré et lissé : déplacez R et Q (niveau local, initialisation diffuse exacte)",
         x_label="année", axes=nile_axes(), run=nile_slider_run,
         time=nile(True).year.astype(float), panels=nile_panels(), fixed={"y": nile(True).flow},
+        readout=nile_readout,
     )

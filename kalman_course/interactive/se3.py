@@ -106,7 +106,6 @@ def se3_spec() -> SliderSpec:
                 x_range=(190.0, 470.0),
                 y_range=(345.0, 120.0),
                 equal_aspect=True,
-                width=600,
             ),
             Panel(
                 "Erreur d'orientation à chaque itération",

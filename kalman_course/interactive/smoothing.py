@@ -16,7 +16,8 @@ from ..scenarios.nile import NILE_DK_VARIANCES, nile_run
 from .grid import ParameterAxis, ParameterGrid, log_grid, precompute_grid
 from .spec import Glyph, Panel
 
-__all__ = ["nile_axes", "nile_slider_run", "nile_grid", "nile_panels", "nile_sliders", "live_nile_explorer"]
+__all__ = ["nile_axes", "nile_slider_run", "nile_grid", "nile_panels", "nile_readout", "nile_sliders",
+           "live_nile_explorer"]
 
 LIVE_HINT = "kc.interactive.live_nile_explorer()"
 UNIT = "(10⁸ m³ par an)²"
@@ -41,6 +42,16 @@ def nile_slider_run(R: float, Q: float) -> dict[str, np.ndarray]:
     run = nile_run(R, Q, missing=True)
     return {"xf": run.filtered.x[:, 0], "xs": run.smoothed.x[:, 0],
             "sf": run.filtered.std()[:, 0], "ss": run.smoothed.std()[:, 0]}
+
+
+def nile_readout(series, values) -> str:
+    """Le texte sous les curseurs : le rapport Q/R et les écarts-types moyens du niveau filtré et lissé."""
+    from .figure import number
+
+    R, Q = values
+    return (f"Rapport Q/R = {number(Q / R)} ; écart-type moyen du niveau : filtre {number(float(np.mean(series['sf'])))}, "
+            f"lisseur {number(float(np.mean(series['ss'])))} (10⁸ m³) ; niveau lissé de "
+            f"{number(float(np.min(series['xs'])))} à {number(float(np.max(series['xs'])))} (10⁸ m³).")
 
 
 def nile_grid(per_decade: int = 2) -> ParameterGrid:

@@ -3,12 +3,13 @@ vivants (matplotlib + ipywidgets) : un chapitre décrit sa figure une fois, les 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Mapping
 
 from ..core.validation import KalmanInputError
 
-__all__ = ["DASHES", "GLYPH_KINDS", "MARKERS", "Glyph", "Panel"]
+__all__ = ["DASHES", "GLYPH_KINDS", "MARKERS", "Follow", "Glyph", "Panel", "panel_ranges", "panel_y_range"]
 
 
 #: Sortes de tracés.
@@ -30,7 +31,9 @@ class Glyph:
     (surface entre 0 et la série) ou ``"band"`` (surface entre ``column`` et la série ``upper``) ;
     ``color`` : nom de couleur CSS ; ``legend`` : légende en français (vide : pas de légende) ;
     ``x`` : série en abscisse (``"t"``, le temps commun, par défaut ; par exemple la coordonnée x d'une
-    trajectoire) ; ``dash``, ``width``, ``alpha``, ``marker``, ``size`` : style du trait ou des marqueurs.
+    trajectoire) ; ``dash``, ``width``, ``alpha``, ``marker``, ``size`` : style du trait ou des marqueurs ;
+    ``clip`` : le tracé peut sortir de l'axe (il ne compte pas dans les bornes automatiques, et les tests
+    ne vérifient pas qu'il y tient : une ellipse a priori de 30 m autour d'un détail de 3 m).
     """
 
     column: str
@@ -45,6 +48,7 @@ class Glyph:
     alpha: float = 1.0
     marker: str = "cross"
     size: float = 8.0
+    clip: bool = False
 
     def __post_init__(self) -> None:
         if self.kind not in GLYPH_KINDS:
@@ -69,9 +73,48 @@ class Glyph:
 
 
 @dataclass(frozen=True)
+class Follow:
+    """Bornes d'ordonnée qui **suivent l'exécution affichée** (à donner comme ``Panel.y_range``).
+
+    À chaque position des curseurs, l'axe couvre les valeurs finies des séries ``columns`` de cette
+    exécution (par défaut : toutes les séries tracées du panneau), les valeurs ``include`` (par
+    exemple 0 pour une densité, qui reste alors le bord de l'axe, sans marge) et une marge relative
+    ``margin`` (échelle logarithmique : décades entières, sans autre marge). ``min_span`` : hauteur minimale de l'axe (en décades sur une échelle
+    logarithmique ; un panneau presque plat n'est pas agrandi jusqu'au bruit d'arrondi) ; ``above`` :
+    marge ajoutée en haut seulement, dans l'unité de l'axe (place d'un repère au-dessus du maximum).
+
+    Les séries hors de ``columns`` peuvent sortir de l'axe : c'est voulu (par exemple une estimation
+    qui sort d'une bande, quand la bande fixe l'échelle). Les tests vérifient, à chaque point de la
+    grille, que les séries ``columns`` sont dans l'axe.
+
+    Panneau plan (``Panel.equal_aspect``) : l'abscisse suit aussi, et ``aspect`` (largeur sur hauteur
+    du cadre, en mètres comme en pixels) reste fixe : le cadre couvre les tracés de l'exécution
+    affichée (abscisses et ordonnées), puis s'élargit dans une direction pour garder ce rapport. Un
+    croissant de 2 m et un de 40 m remplissent alors tous deux le panneau, sans le déformer.
+    """
+
+    columns: tuple[str, ...] | None = None
+    include: tuple[float, ...] = ()
+    margin: float = 0.05
+    min_span: float = 0.0
+    above: float = 0.0
+    aspect: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.aspect is not None and not (math.isfinite(self.aspect) and self.aspect > 0):
+            raise KalmanInputError(f"« aspect » doit être un nombre strictement positif ; reçu {self.aspect!r}.")
+        if self.columns is not None:
+            object.__setattr__(self, "columns", tuple(self.columns))
+        object.__setattr__(self, "include", tuple(float(v) for v in self.include))
+        if not (self.margin >= 0 and self.min_span >= 0 and self.above >= 0):
+            raise KalmanInputError("« margin », « min_span » et « above » doivent être positifs ou nuls.")
+
+
+@dataclass(frozen=True)
 class Panel:
     """Un panneau : titre, ordonnée (avec unité), tracés ; ``y_log`` pour une échelle logarithmique,
-    ``y_range`` pour des bornes fixes (sinon calculées sur toutes les exécutions) ; ``height`` en pixels.
+    ``y_range`` pour des bornes fixes, ou :class:`Follow` pour des bornes qui suivent l'exécution
+    affichée (par défaut : bornes fixes calculées sur toutes les exécutions) ; ``height`` en pixels.
 
     Par défaut l'abscisse est le temps commun de la figure (axe partagé par les panneaux). Un panneau
     dont les tracés ont une autre abscisse (``Glyph.x``, par exemple une trajectoire) donne son
@@ -84,7 +127,7 @@ class Panel:
     y_label: str
     glyphs: tuple[Glyph, ...]
     y_log: bool = False
-    y_range: tuple[float, float] | None = None
+    y_range: tuple[float, float] | Follow | None = None
     height: int = 230
     x_label: str | None = None
     x_range: tuple[float, float] | None = None
@@ -102,12 +145,125 @@ class Panel:
             )
         if self.equal_aspect and (self.x_range is None or self.y_range is None):
             raise KalmanInputError(f"Le panneau « {self.title} » : « equal_aspect » exige x_range et y_range.")
+        if self.follows and (self.equal_aspect != (self.y_range.aspect is not None)):
+            raise KalmanInputError(
+                f"Le panneau « {self.title} » : un plan (« equal_aspect ») qui suit les données donne le rapport "
+                "« aspect » de son cadre à Follow, et seul un plan le donne.")
 
+
+    @property
+    def follows(self) -> bool:
+        """Vrai si l'ordonnée suit l'exécution affichée (``y_range`` est un :class:`Follow`)."""
+        return isinstance(self.y_range, Follow)
+
+    @property
+    def follows_plane(self) -> bool:
+        """Vrai si les deux axes suivent l'exécution affichée (plan à rapport fixe, :class:`Follow` ``aspect``)."""
+        return self.follows and self.y_range.aspect is not None
+
+    def aspect(self, y_range: tuple[float, float] | None = None) -> float:
+        """Largeur sur hauteur du cadre d'un plan (``equal_aspect``)."""
+        if self.follows_plane:
+            return float(self.y_range.aspect)
+        (x0, x1), (y0, y1) = self.x_range, y_range if y_range is not None else self.y_range
+        return abs((x1 - x0) / (y1 - y0))
+
+    def x_columns(self) -> tuple[str, ...]:
+        """Les abscisses des tracés qui fixent les bornes (plan qui suit les données)."""
+        columns = self.range_columns()
+        return tuple(dict.fromkeys(g.x for g in self.glyphs
+                                   if g.kind not in ("hline", "vline") and not g.clip and g.column in columns))
+
+    def range_columns(self) -> tuple[str, ...]:
+        """Les séries qui fixent l'ordonnée : celles de :class:`Follow` ou, sinon, toutes les séries tracées
+        en ordonnée (bords des surfaces compris), sauf celles des tracés ``clip``."""
+        if self.follows and self.y_range.columns is not None:
+            return self.y_range.columns
+        out: list[str] = []
+        for glyph in self.glyphs:
+            if glyph.kind in ("hline", "vline") or glyph.clip:
+                continue
+            out += [glyph.column] + ([glyph.upper] if glyph.kind == "band" else [])
+        return tuple(dict.fromkeys(out))
 
     @property
     def own_x(self) -> bool:
         """Vrai si l'abscisse n'est pas le temps commun."""
         return any(g.x != "t" for g in self.glyphs) or self.x_range is not None
+
+
+def _bounds(values, *, log: bool, margin: float, min_span: float = 0.0, above: float = 0.0,
+            fixed: tuple[float, ...] = (), title: str = "") -> tuple[float, float]:
+    """Bornes d'un axe couvrant ``values`` : décades entières (log) ou marge relative (linéaire) ; une
+    borne égale à une valeur de ``fixed`` n'a pas de marge."""
+    import numpy as np
+
+    v = np.asarray(values, dtype=float).ravel()
+    v = v[np.isfinite(v)]
+    if log:
+        v = v[v > 0]
+        if v.size == 0:
+            raise KalmanInputError(f"Panneau « {title} » : échelle log sans valeur strictement positive.")
+        lo, hi = np.floor(np.log10(v.min())), np.ceil(np.log10(v.max()))
+        if hi - lo < max(min_span, 1.0):
+            hi = lo + max(min_span, 1.0)
+        return float(10.0 ** lo), float(10.0 ** hi)
+    if v.size == 0:
+        raise KalmanInputError(f"Panneau « {title} » : aucune valeur finie à tracer, donnez « y_range ».")
+    lo, hi = float(v.min()), float(v.max())
+    if hi - lo < min_span:
+        middle = 0.5 * (hi + lo)
+        lo, hi = middle - 0.5 * min_span, middle + 0.5 * min_span
+    pad = margin * (hi - lo) if hi > lo else max(abs(hi), 1.0) * max(margin, 0.05)
+    # une borne imposée (le 0 d'une densité) reste le bord de l'axe, sans marge
+    return lo - (0.0 if lo in fixed else pad), hi + (0.0 if hi in fixed else pad) + above
+
+
+def panel_y_range(panel: Panel, data) -> tuple[float, float]:
+    """Bornes de l'ordonnée du panneau pour les séries ``data`` (dict nom → valeurs ; une exécution, ou
+    toutes les exécutions d'une grille mises bout à bout). Marge ``margin`` ignorée en échelle
+    logarithmique (décades entières).
+
+    Bornes fixes : ``panel.y_range`` ; :class:`Follow` : les séries de ``Follow.columns`` de ``data``
+    et ses valeurs ``include`` ; sinon toutes les séries tracées, les droites horizontales et le 0 des
+    surfaces (``"area"``), marge de 5 % (décades entières en échelle logarithmique).
+    """
+    import numpy as np
+
+    if panel.y_range is not None and not panel.follows:
+        return tuple(panel.y_range)
+    values = [np.asarray(data[c], dtype=float).ravel() for c in panel.range_columns()]
+    follow = panel.y_range if panel.follows else Follow()
+    if panel.follows:
+        values.append(np.array(follow.include))
+    else:
+        values += [np.array([g.value], dtype=float) for g in panel.glyphs if g.kind == "hline"]
+        if any(g.kind == "area" for g in panel.glyphs):
+            values.append(np.zeros(1))
+    return _bounds(np.concatenate(values) if values else np.zeros(0), log=panel.y_log, margin=follow.margin,
+                   min_span=follow.min_span, above=follow.above, fixed=follow.include, title=panel.title)
+
+
+def panel_ranges(panel: Panel, data) -> tuple[tuple[float, float] | None, tuple[float, float]]:
+    """``(abscisse, ordonnée)`` du panneau pour les séries ``data`` : l'abscisse n'est donnée (sinon
+    ``None``) que pour un plan qui suit les données (:attr:`Panel.follows_plane`) ; son cadre couvre
+    les tracés, avec la marge de :class:`Follow`, élargi pour garder le rapport ``aspect``."""
+    import numpy as np
+
+    y = panel_y_range(panel, data)
+    if not panel.follows_plane:
+        return None, y
+    follow = panel.y_range
+    xs = np.concatenate([np.asarray(data[c], dtype=float).ravel() for c in panel.x_columns()])
+    x = _bounds(xs, log=False, margin=follow.margin, title=panel.title)
+    width, height = x[1] - x[0], y[1] - y[0]
+    if width / height < follow.aspect:  # trop étroit : on élargit l'abscisse autour de son centre
+        middle, width = 0.5 * (x[0] + x[1]), height * follow.aspect
+        x = (middle - 0.5 * width, middle + 0.5 * width)
+    else:  # trop plat : on agrandit l'ordonnée
+        middle, height = 0.5 * (y[0] + y[1]), width / follow.aspect
+        y = (middle - 0.5 * height, middle + 0.5 * height)
+    return (float(x[0]), float(x[1])), (float(y[0]), float(y[1]))
 
 
 def check_columns(panels, known: set[str], lengths: Mapping[str, int] | None = None) -> None:
@@ -207,10 +363,11 @@ def draw_panels(panels, data, x_label: str, *, height_px_per_inch: float = 80.0)
             ax.set_yscale("log")
         if panel.x_log:
             ax.set_xscale("log")
-        if panel.y_range is not None:
-            ax.set_ylim(*panel.y_range)
-        if panel.x_range is not None:
-            ax.set_xlim(*panel.x_range)
+        x_limits, y_limits = panel_ranges(panel, data) if panel.y_range is not None else (None, None)
+        if y_limits is not None:
+            ax.set_ylim(*y_limits)
+        if x_limits is not None or panel.x_range is not None:
+            ax.set_xlim(*(x_limits or panel.x_range))
         if panel.equal_aspect:
             ax.set_aspect("equal")
         ax.set_title(panel.title, fontsize=10)

@@ -31,13 +31,11 @@ from typing import Callable, Mapping
 
 import bokeh
 import numpy as np
-from bokeh.embed import json_item
 from bokeh.layouts import column, row
 from bokeh.models import (
     ColumnDataSource,
     CustomJS,
     CustomJSTickFormatter,
-    Div,
     Legend,
     LegendItem,
     Range1d,
@@ -49,7 +47,7 @@ from ..core.validation import KalmanInputError, as_float_array
 from ..typography import french_spacing
 from ..numbers import bokeh_tick_formatter
 from .grid import ParameterGrid
-from .spec import Panel, check_columns
+from .spec import Panel, check_columns, panel_ranges, panel_y_range
 
 __all__ = ["MARKER", "CAPTION_ATTRIBUTE", "BOKEH_VERSION", "PLOTTED_SOURCE", "bokehjs_files", "plotted_source_name",
            "StaticSliders"]
@@ -88,7 +86,8 @@ def installed_bokehjs() -> dict[str, Path]:
 
 # Rappel exécuté par le navigateur à chaque mouvement d'un curseur : l'exécution d'indice plat
 # k = (i·N1 + j)·N2 + … occupe, pour une série de longueur L, les indices [k·L, (k + 1)·L) de sa
-# version aplatie ; les séries sont groupées par longueur (une source tracée par longueur).
+# version aplatie ; les séries sont groupées par longueur (une source tracée par longueur). Les
+# panneaux dont l'ordonnée suit l'exécution (Follow) reçoivent leurs bornes précalculées.
 _CALLBACK = """
 let k = 0;
 for (let a = 0; a < sliders.length; a++) k = k * dims[a] + Math.round(sliders[a].value);
@@ -99,7 +98,16 @@ for (let g = 0; g < sources.length; g++) {
   for (const name of names[g]) data[name] = grid.data[name].slice(k * n, (k + 1) * n);
   source.data = data;
 }
-if (readout !== null) readout.text = texts[k];
+for (let p = 0; p < follow.length; p++) {
+  const b = bounds[p];
+  if (b[4 * k] !== null) follow[p].x_range.setv({start: b[4 * k], end: b[4 * k + 1]});
+  follow[p].y_range.setv({start: b[4 * k + 2], end: b[4 * k + 3]});
+}
+if (texts.length) {
+  const el = document.getElementById(readout);
+  if (el) el.textContent = texts[k];
+}
+if (window.kcFigures) window.kcFigures.announce(readout.slice(0, -8));
 """
 
 
@@ -107,13 +115,14 @@ if (readout !== null) readout.text = texts[k];
 LEGEND_WIDTH = 600
 
 
-def _legend_rows(items) -> int:
-    """Nombre de lignes de la légende pour qu'elle tienne dans la colonne du livre (largeur estimée :
-    6,3 px par caractère en 9 pt, plus le symbole)."""
+def _legend_rows(items, width: float = LEGEND_WIDTH) -> int:
+    """Nombre de lignes de la légende pour qu'elle tienne dans ``width`` pixels (la colonne du livre, ou
+    la moitié pour deux panneaux côte à côte ; largeur estimée : 6,3 px par caractère en 9 pt, plus le
+    symbole)."""
     widths = [6.3 * len(item.label.value if hasattr(item.label, "value") else str(item.label)) + 40 for item in items]
     rows, used = 1, 0.0
     for w in widths:
-        if used and used + w > LEGEND_WIDTH:
+        if used and used + w > width:
             rows, used = rows + 1, 0.0
         used += w
     return rows
@@ -206,6 +215,12 @@ class StaticSliders:
 
     # ------------------------------------------------------------------ construction Bokeh
 
+    @property
+    def columns(self) -> int:
+        """Panneaux par ligne sur un grand écran : deux si la figure a un plan (``equal_aspect``) et
+        plusieurs panneaux, sinon un (la page passe à un par ligne sur un écran étroit)."""
+        return 2 if any(p.equal_aspect for p in self.panels) and len(self.panels) > 1 else 1
+
     def _sliders(self) -> list[Slider]:
         sliders = []
         for k, axis in enumerate(self.grid.axes):
@@ -232,34 +247,51 @@ class StaticSliders:
         return self.fixed[name]
 
     def _y_range(self, panel: Panel) -> tuple[float, float]:
-        """Bornes fixes de l'ordonnée, communes à toute la grille : en déplaçant un curseur, on voit
-        la courbe bouger, pas l'axe. Échelle log : décades entières ; sinon marge de 5 %."""
-        if panel.y_range is not None:
-            return panel.y_range
-        values = []
-        for glyph in panel.glyphs:
-            if glyph.kind == "hline":
-                values.append(np.array([glyph.value], dtype=float))
-            elif glyph.kind == "vline":
-                continue
-            else:
-                values.append(self._column_values(glyph.column))
-                if glyph.kind == "area":
-                    values.append(np.zeros(1))
-                if glyph.kind == "band":
-                    values.append(self._column_values(glyph.upper))
-        v = np.concatenate(values) if values else np.zeros(0)
-        v = v[np.isfinite(v)]
-        if panel.y_log:
-            v = v[v > 0]
-            if v.size == 0:
-                raise KalmanInputError(f"Panneau « {panel.title} » : échelle log sans valeur strictement positive.")
-            return 10.0 ** np.floor(np.log10(v.min())), 10.0 ** np.ceil(np.log10(v.max()))
-        if v.size == 0:
-            raise KalmanInputError(f"Panneau « {panel.title} » : aucune valeur finie à tracer, donnez « y_range ».")
-        lo, hi = float(v.min()), float(v.max())
-        pad = 0.05 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.05
-        return lo - pad, hi + pad
+        """Bornes de l'ordonnée communes à toute la grille : en déplaçant un curseur, on voit la courbe
+        bouger, pas l'axe (échelle log : décades entières ; sinon marge de 5 %). Un panneau
+        :class:`~.spec.Follow` a ses bornes à chaque exécution (:meth:`follow_ranges`) ; ici, leur union."""
+        if panel.follows:
+            bounds = self.follow_ranges()[self.panels.index(panel)]
+            return float(bounds[:, 2].min()), float(bounds[:, 3].max())
+        return panel_y_range(panel, {name: self._column_values(name) for name in panel.range_columns()})
+
+    def follow_ranges(self) -> list[np.ndarray | None]:
+        """Bornes de chaque panneau :class:`~.spec.Follow` à chaque exécution : tableau ``(N0·N1·…, 4)``
+        ``(x0, x1, y0, y1)`` dans l'ordre plat de la grille (``x0 = x1 = NaN`` si l'abscisse ne suit pas) ;
+        ``None`` pour un panneau à bornes fixes."""
+        if getattr(self, "_follow_ranges", None) is None:
+            grid = self.grid
+            runs = [{"t": grid.time, **self.fixed, **grid.run(*index)}
+                    for index in itertools.product(*(range(n) for n in grid.shape))]
+            out = []
+            for panel in self.panels:
+                if not panel.follows:
+                    out.append(None)
+                    continue
+                rows = []
+                for run in runs:
+                    x, y = panel_ranges(panel, run)
+                    rows.append((*(x if x is not None else (np.nan, np.nan)), *y))
+                out.append(np.array(rows))
+            self._follow_ranges = out
+        return self._follow_ranges
+
+    def y_range_at(self, panel: int, *index: int) -> tuple[float, float]:
+        """Bornes de l'ordonnée du panneau n° ``panel`` quand les curseurs sont au point ``index``."""
+        return self.ranges_at(panel, *index)[1]
+
+    def ranges_at(self, panel: int, *index: int) -> tuple[tuple[float, float], tuple[float, float]]:
+        """``(abscisse, ordonnée)`` du panneau n° ``panel`` quand les curseurs sont au point ``index`` (abscisse
+        du temps commun pour un panneau qui n'a pas la sienne)."""
+        p = self.panels[panel]
+        ranges = self.follow_ranges()[panel]
+        x = tuple(p.x_range) if p.own_x else (float(self.grid.time[0]) - 0.5, float(self.grid.time[-1]) + 0.5)
+        if ranges is None:
+            return x, self._y_range(p)
+        row = ranges[int(np.ravel_multi_index(index, self.grid.shape))]
+        if np.isfinite(row[0]):
+            x = (float(row[0]), float(row[1]))
+        return x, (float(row[2]), float(row[3]))
 
     def _sources(self):
         """Une source tracée par longueur de série (« t » et séries du temps commun ensemble), et la
@@ -292,21 +324,21 @@ class StaticSliders:
 
         figures = []
         time_range = Range1d(float(grid.time[0]) - 0.5, float(grid.time[-1]) + 0.5)
-        for panel in self.panels:
-            y_range = self._y_range(panel)
+        follow, bounds = [], []
+        for p, panel in enumerate(self.panels):
+            x_range, y_range = self.ranges_at(p, *grid.default_index)
             size = {"height": panel.height, "sizing_mode": "stretch_width"}
             if panel.equal_aspect:
                 # même échelle en x et en y : rapport largeur/hauteur fixé par les bornes
-                (x0, x1), (y0, y1) = panel.x_range, y_range
-                ratio = abs((x1 - x0) / (y1 - y0))
+                ratio = panel.aspect(y_range)
                 size = {"aspect_ratio": ratio, "sizing_mode": "scale_width"}
                 if panel.width is not None:
                     size = {"width": panel.width, "height": int(round(panel.width / ratio)), "sizing_mode": "fixed"}
             fig = figure(
-                title=french_spacing(panel.title),
+                # le titre du panneau est écrit par la page (HTML, il passe à la ligne) : pas dans le canevas
                 tools="pan,box_zoom,wheel_zoom,reset,save",
                 toolbar_location="right",
-                x_range=Range1d(*panel.x_range) if panel.own_x else time_range,
+                x_range=Range1d(*x_range) if panel.own_x else time_range,
                 y_range=Range1d(*y_range),
                 y_axis_type="log" if panel.y_log else "linear",
                 x_axis_type="log" if panel.x_log else "linear",
@@ -328,20 +360,22 @@ class StaticSliders:
             if items:
                 fig.add_layout(
                     Legend(items=items, orientation="horizontal", location="top_left", label_text_font_size="9pt",
-                           border_line_alpha=0, margin=0, padding=2, nrows=_legend_rows(items)),
+                           border_line_alpha=0, margin=0, padding=2,
+                           nrows=_legend_rows(items, LEGEND_WIDTH / self.columns)),
                     "above",
                 )
             figures.append(fig)
+            if panel.follows:
+                follow.append(fig)
+                bounds.append([None if not np.isfinite(v) else float(v)
+                               for v in np.ascontiguousarray(self.follow_ranges()[p]).reshape(-1)])
 
         sliders = self._sliders()
-        readout = None
         texts: list[str] = []
         if self.readout is not None:
             texts = [french_spacing(str(self.readout(index)))
                      for index in itertools.product(*(range(n) for n in grid.shape))]
-            readout = Div(text=texts[int(np.ravel_multi_index(grid.default_index, grid.shape))],
-                          name="kc-readout", css_classes=["kc-readout"], render_as_text=True,
-                          sizing_mode="stretch_width")
+        self._texts = texts
         callback = CustomJS(
             args={
                 "sliders": sliders,
@@ -350,16 +384,56 @@ class StaticSliders:
                 "grids": grids,
                 "names": names,
                 "lengths": lengths,
-                "readout": readout,
+                "readout": f"{self.element_id}-readout",
                 "texts": texts,
+                "follow": follow,
+                "bounds": bounds,
             },
             code=_CALLBACK,
         )
         for slider in sliders:
             slider.js_on_change("value", callback)
-        header = [Div(text=f"<strong>{html.escape(french_spacing(self.title))}</strong>")] if self.title else []
-        controls = [row(*sliders, sizing_mode="stretch_width")] + ([readout] if readout is not None else [])
-        return column(*header, *controls, *figures, sizing_mode="stretch_width")
+        self.sliders, self.figures = sliders, figures
+        return column(row(*sliders, sizing_mode="stretch_width"), *figures, sizing_mode="stretch_width")
+
+    @property
+    def element_id(self) -> str:
+        """Identifiant HTML de la figure (stable : il ne dépend que du nom et de la grille)."""
+        if getattr(self, "_element_id", None) is None:
+            h = hashlib.sha1(self.name.encode())
+            for name in sorted(self.grid.series):
+                h.update(name.encode())
+                h.update(np.ascontiguousarray(self.grid.series[name]).tobytes())
+            self._element_id = f"kc-{self.name}-{h.hexdigest()[:10]}"
+        return self._element_id
+
+    def document_json(self) -> dict:
+        """Le document Bokeh de la figure, prêt pour ``Bokeh.embed.embed_items`` : ``{"docs_json", "render_items"}``.
+
+        Une racine par élément de la page : chaque curseur (``<id>-slider-<s>``) et chaque panneau
+        (``<id>-panel-<k>``). La page place elle-même ces éléments (CSS) : curseurs et panneaux côte à
+        côte sur un grand écran, l'un sous l'autre sur un téléphone.
+        """
+        from bokeh.document import Document
+
+        roots = {slider: f"{self.element_id}-slider-{k}" for k, slider in enumerate(self.sliders)}
+        roots.update({fig: f"{self.element_id}-panel-{k}" for k, fig in enumerate(self.figures)})
+        controls = self.layout.children[0]
+        saved = (list(self.layout.children), list(controls.children))
+        self.layout.children, controls.children = [], []  # chaque élément devient une racine du document
+        doc = Document()
+        for model in roots:
+            doc.add_root(model)
+        docid = f"{self.element_id}-doc"
+        out = {
+            "docs_json": {docid: doc.to_json(deferred=False)},
+            "render_items": [{"docid": docid, "roots": {m.id: e for m, e in roots.items()},
+                              "root_ids": [m.id for m in roots]}],
+        }
+        for model in roots:
+            doc.remove_root(model)
+        self.layout.children, controls.children = saved
+        return out
 
     def _glyph(self, fig, panel: Panel, glyph, source_of):
         """Dessine un tracé ; renvoie son « renderer » Bokeh."""
@@ -413,16 +487,29 @@ class StaticSliders:
 
     # ------------------------------------------------------------------ sortie HTML
 
-    def html(self) -> str:
-        """Le fragment HTML de la figure : conteneur, données (JSON) et script d'insertion.
+    def panel_label(self, k: int) -> str:
+        """Texte de remplacement du panneau ``k`` (lecteurs d'écran) : son titre, ses axes et ses tracés."""
+        panel = self.panels[k]
+        legends = [french_spacing(g.legend) for g in panel.glyphs if g.legend]
+        x_label = french_spacing(panel.x_label or self.x_label)
+        text = (f"Graphique : {french_spacing(panel.title)}. Abscisse : {x_label} ; ordonnée : "
+                f"{french_spacing(panel.y_label)}.")
+        if legends:
+            text += f" Tracés : {' ; '.join(legends)}."
+        return text
 
-        Le script suppose BokehJS déjà chargé (``window.Bokeh``) ; sinon il affiche un message.
+    def html(self) -> str:
+        """Le fragment HTML de la figure : titre, emplacements des curseurs, du texte de lecture et des
+        panneaux, données (JSON) et script d'insertion.
+
+        Dans le livre, le script de la page (``kc-pages.js``, extension :mod:`kalman_course.sphinx.pages`)
+        charge BokehJS et dessine la figure quand elle approche de l'écran ; sans lui, le script de la
+        figure la dessine aussitôt si BokehJS est déjà chargé, et sinon le message reste affiché.
         """
-        item = json.dumps(json_item(self.layout), separators=(",", ":"), allow_nan=False)
+        item = json.dumps(self.document_json(), separators=(",", ":"), allow_nan=False)
         # « </ » fermerait la balise <script> : échappement JSON équivalent
         item = item.replace("</", "<\\/").replace("<!--", "<\\!--")
-        digest = hashlib.sha1(item.encode()).hexdigest()[:10]
-        root_id = f"kc-{self.name}-{digest}"
+        root_id = self.element_id
         hint = f" (<code>{html.escape(self.live_hint)}</code>)" if self.live_hint else ""
         # Message visible seulement si BokehJS manque (carnet ouvert dans Jupyter, par exemple) :
         # dans le livre, le script l'efface avant d'insérer la figure.
@@ -430,17 +517,43 @@ class StaticSliders:
             "Figure à curseurs précalculés : elle s’affiche dans le livre publié, qui sert BokehJS. "
             f"Dans Jupyter, utilisez les curseurs vivants{hint}."
         )
+        title = html.escape(french_spacing(self.title or f"Figure à curseurs « {self.name} »"))
+        texts = getattr(self, "_texts", [])
+        default = int(np.ravel_multi_index(self.grid.default_index, self.grid.shape))
+        readout = (f'<p class="kc-readout" id="{root_id}-readout" aria-live="polite">'
+                   f'{html.escape(texts[default])}</p>\n') if texts else ""
+        columns = self.columns
+        sliders = "".join(f'<div class="kc-bokeh-slider" id="{root_id}-slider-{k}"></div>'
+                          for k in range(len(self.grid.axes)))
+        described = json.dumps([{"name": french_spacing(f"{a.symbol} — {a.description}"),
+                                 "values": [french_spacing(v) for v in a.labels()]} for a in self.grid.axes],
+                               ensure_ascii=False, separators=(",", ":")).replace("</", "<\\/")
+        panels = "".join(
+            f'<div class="kc-bokeh-panel{" kc-bokeh-plane" if p.equal_aspect else ""}" id="{root_id}-panel-{k}-box" '
+            f'role="figure" aria-label="{html.escape(self.panel_label(k), quote=True)}">'
+            f'<p class="kc-panel-title" aria-hidden="true">{html.escape(french_spacing(p.title))}</p>'
+            f'<div class="kc-bokeh-canvas" id="{root_id}-panel-{k}"></div></div>'
+            for k, p in enumerate(self.panels)
+        )
         return (
-            f'<div class="kc-bokeh-figure" {MARKER}="{self.name}" data-bokeh-version="{BOKEH_VERSION}" '
-            f'{CAPTION_ATTRIBUTE}="{html.escape(self.caption(), quote=True)}">\n'
-            f'<div id="{root_id}" class="kc-bokeh-root"><p class="kc-bokeh-missing">{missing}</p></div>\n'
+            f'<div class="kc-bokeh-figure" id="{root_id}-figure" {MARKER}="{self.name}" '
+            f'data-bokeh-version="{BOKEH_VERSION}" {CAPTION_ATTRIBUTE}="{html.escape(self.caption(), quote=True)}" '
+            f'role="group" aria-labelledby="{root_id}-title" tabindex="-1">\n'
+            f'<p class="kc-bokeh-title" id="{root_id}-title"><strong>{title}</strong></p>\n'
+            f'<div id="{root_id}" class="kc-bokeh-root" data-columns="{columns}">'
+            f'<p class="kc-bokeh-missing">{missing}</p>'
+            f'<div class="kc-bokeh-controls" id="{root_id}-controls">{sliders}{readout}</div>\n'
+            f'<div class="kc-bokeh-panels">{panels}</div></div>\n'
+            f'<script type="application/json" id="{root_id}-sliders">{described}</script>\n'
             f'<script type="application/json" id="{root_id}-item">{item}</script>\n'
             "<script>(function () {\n"
+            f'  var id = "{root_id}";\n'
+            "  if (window.kcFigures) { window.kcFigures.register(id); return; }\n"
             '  if (typeof window.Bokeh === "undefined" || !window.Bokeh.embed) return;\n'
-            f'  var root = document.getElementById("{root_id}");\n'
-            '  root.textContent = "";\n'
-            f'  var item = JSON.parse(document.getElementById("{root_id}-item").textContent);\n'
-            f'  window.Bokeh.embed.embed_item(item, root);\n'
+            '  var root = document.getElementById(id);\n'
+            '  root.removeChild(root.querySelector(".kc-bokeh-missing"));\n'
+            '  var item = JSON.parse(document.getElementById(id + "-item").textContent);\n'
+            "  window.Bokeh.embed.embed_items(item.docs_json, item.render_items);\n"
             "})();</script>\n"
             "</div>\n"
         )

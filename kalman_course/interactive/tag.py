@@ -125,6 +125,17 @@ def live_tag_explorer(accel_std: float = TAG_ACCEL_STD, range_std: float = TAG_R
     )
 
 
+def tag_readout(series, values) -> str:
+    """Le texte sous les curseurs : l'erreur de position vraie et l'écart-type annoncé, en moyenne."""
+    from .figure import number
+
+    err, sigma = series["err"], series["sigma"]
+    rms = float(np.sqrt(np.mean(err ** 2)))
+    announced = float(np.sqrt(np.mean(sigma ** 2)))
+    return (f"Erreur de position (moyenne quadratique) : {number(rms, 'm')} ; écart-type annoncé par le filtre : "
+            f"{number(announced, 'm')} (rapport {number(announced / rms)} ; proche de 1 si le filtre est cohérent).")
+
+
 @register_sliders("tag-curseurs", chapter="suivi-tag")
 def tag_spec(per_decade: int = 3) -> SliderSpec:
     r"""La figure :math:`(\sigma_a, \sigma_r)` du chapitre au registre des figures à curseurs (même grille
@@ -140,4 +151,5 @@ def tag_spec(per_decade: int = 3) -> SliderSpec:
         time=data.t,
         panels=tag_panels(),
         fixed=_fixed(data),
+        readout=tag_readout,
     )

@@ -21,7 +21,7 @@ import numpy as np
 from ..figures._geometry import ellipse_points
 from ..scenarios import banana
 from .grid import ParameterAxis, ParameterGrid, format_value, precompute_grid
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = [
     "N_POINTS",
@@ -36,6 +36,8 @@ __all__ = [
     "banana_parameter_run",
     "banana_uncertainty_sliders",
     "banana_parameter_sliders",
+    "banana_uncertainty_readout",
+    "banana_parameter_readout",
 ]
 
 #: Nombre de points de chaque série (ellipses, nuage).
@@ -78,7 +80,7 @@ def banana_series(range_std: float, bearing_std: float, *, alpha: float = banana
     return out
 
 
-def _panel(title: str, method: str, y_range: tuple[float, float]) -> Panel:
+def _panel(title: str, method: str, aspect: float) -> Panel:
     """Un panneau : nuage et vérité (ellipse à 2σ, moyenne), puis la méthode ``"lin"`` (EKF) ou ``"ut"``
     (UKF, avec les images des points sigma). Légendes courtes : elles tiennent sur une ligne."""
     name, color = ("EKF", "firebrick") if method == "lin" else ("UKF", "royalblue")
@@ -91,8 +93,9 @@ def _panel(title: str, method: str, y_range: tuple[float, float]) -> Panel:
     ]
     if method == "ut":
         glyphs.append(Glyph("sig_y", "scatter", "navy", "points σ", x="sig_x"))
-    return Panel(title, "y (m)", tuple(glyphs), x_label="x (m)", x_range=(-1.1, 1.1), y_range=y_range,
-                 equal_aspect=True)
+    # le cadre suit la banane affichée (2,5° : quelques centimètres ; 40° : tout l'arc), rapport fixe
+    return Panel(title, "y (m)", tuple(glyphs), x_label="x (m)", x_range=(-1.1, 1.1),
+                 y_range=Follow(aspect=aspect, margin=0.06), equal_aspect=True)
 
 
 def banana_uncertainty_axes() -> tuple[ParameterAxis, ParameterAxis]:
@@ -133,14 +136,14 @@ def banana_parameter_grid() -> ParameterGrid:
 def banana_uncertainty_panels() -> tuple[Panel, ...]:
     """Linéarisation (EKF) puis transformée unscented (UKF), chacune contre la vérité."""
     return (
-        _panel("Linéarisation (EKF) contre vérité — ellipses à 2σ", "lin", (-0.1, 1.35)),
-        _panel("Transformée unscented (UKF) contre vérité — ellipses à 2σ", "ut", (-0.1, 1.35)),
+        _panel("Linéarisation (EKF) contre vérité — ellipses à 2σ", "lin", 1.2),
+        _panel("Transformée unscented (UKF) contre vérité — ellipses à 2σ", "ut", 1.2),
     )
 
 
 def banana_parameter_panels() -> tuple[Panel, ...]:
     """La transformée unscented contre la vérité (σθ = 20°, σᵣ = 2 cm)."""
-    return (_panel("Transformée unscented (UKF) contre vérité — ellipses à 2σ", "ut", (0.35, 1.3)),)
+    return (_panel("Transformée unscented (UKF) contre vérité — ellipses à 2σ", "ut", 1.6),)
 
 
 def banana_uncertainty_run(bearing_deg: float, range_std: float) -> dict[str, np.ndarray]:
@@ -154,26 +157,57 @@ def banana_parameter_run(alpha: float, n_plus_kappa: float) -> dict[str, np.ndar
                          kappa=n_plus_kappa - _N, cloud=False)
 
 
-def banana_uncertainty_sliders():
-    r"""Figure à curseurs statiques :math:`\sigma_\theta`, :math:`\sigma_r` (Bokeh)."""
-    from .static import StaticSliders
+def _area(x: np.ndarray, y: np.ndarray) -> float:
+    """Aire d'un polygone fermé (formule du lacet) : celle d'une ellipse tracée point par point."""
+    return 0.5 * abs(float(np.dot(x, np.roll(y, 1)) - np.dot(y, np.roll(x, 1))))
 
-    return StaticSliders(
-        banana_uncertainty_grid(), banana_uncertainty_panels(), x_label="x (m)",
-        name="ukf-banane-incertitude",
-        title="La banane (r = 1 m, θ = 90°) : déplacez les incertitudes d'azimut et de distance",
-    )
+
+def _moments_text(series, methods) -> str:
+    from .figure import number
+
+    def coordinate(v: float) -> str:  # 6 × 10⁻¹⁷ m est un zéro d'arrondi
+        return number(0.0 if abs(v) < 1e-9 else v, significant=2)
+
+    def pair(key: str) -> str:
+        return f"({coordinate(series[f'{key}_mx'][0])} ; {coordinate(series[f'{key}_my'][0])}) m"
+
+    truth_area = _area(series["truth_x"], series["truth_y"])
+    parts = [f"Moyenne vraie {pair('truth')}"]
+    for key, label in methods:
+        gap = float(np.hypot(series[f"{key}_mx"][0] - series["truth_mx"][0],
+                             series[f"{key}_my"][0] - series["truth_my"][0]))
+        ratio = _area(series[f"{key}_x"], series[f"{key}_y"]) / truth_area
+        parts.append(f"{label} {pair(key)}, à {number(1000 * gap, 'mm', significant=2)} de la vraie, ellipse "
+                     f"d'aire × {number(ratio, significant=2)}")
+    return " ; ".join(parts) + "."
+
+
+def banana_uncertainty_readout(series, values) -> str:
+    """Le texte sous les curseurs σθ, σᵣ : les moyennes et les aires des ellipses, comparées aux vraies."""
+    return _moments_text(series, (("lin", "EKF"), ("ut", "UKF")))
+
+
+def banana_parameter_readout(series, values) -> str:
+    """Le texte sous les curseurs α, κ : l'écartement des points sigma, la moyenne et l'ellipse de l'UKF."""
+    from .figure import number
+
+    alpha, n_plus_kappa = values
+    scale = alpha * np.sqrt(n_plus_kappa)
+    return (f"Points sigma à √(n + λ) = α √(n + κ) = {number(scale, significant=2)} écart-type de la moyenne. "
+            + _moments_text(series, (("ut", "UKF"),)))
+
+
+def banana_uncertainty_sliders():
+    r"""Figure à curseurs statiques :math:`\sigma_\theta`, :math:`\sigma_r` (Bokeh) : celle du registre,
+    ``kc.interactive.sliders("ukf-banane-incertitude")``."""
+    from .figure import sliders
+
+    return sliders("ukf-banane-incertitude")
 
 
 def banana_parameter_sliders():
     r"""Figure à curseurs statiques :math:`\alpha`, :math:`\kappa` (Bokeh), :math:`\sigma_\theta = 20°`,
-    :math:`\sigma_r = 2` cm."""
-    from .static import StaticSliders
+    :math:`\sigma_r = 2` cm : celle du registre, ``kc.interactive.sliders("ukf-banane-parametres")``."""
+    from .figure import sliders
 
-    sample = banana.banana_sample(N_POINTS)
-    return StaticSliders(
-        banana_parameter_grid(), banana_parameter_panels(), x_label="x (m)",
-        fixed={"cloud_x": sample[:, 0], "cloud_y": sample[:, 1]},
-        name="ukf-banane-parametres",
-        title="Les paramètres des points sigma : α et κ (σθ = 20°, σᵣ = 2 cm)",
-    )
+    return sliders("ukf-banane-parametres")

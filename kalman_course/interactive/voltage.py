@@ -152,6 +152,16 @@ def live_voltage_explorer(Q: float = VOLTAGE_Q, R: float = VOLTAGE_R, P0: float 
     )
 
 
+def voltage_readout(series, values) -> str:
+    """Le texte sous les curseurs : le gain et la covariance au premier et au dernier relevé, l'erreur finale."""
+    from .figure import number
+
+    x, P, K = series["x"], series["P"], series["K"]
+    return (f"Gain K₁ = {number(K[0])} au premier relevé, K₅₀ = {number(K[-1])} au dernier ; P₅₀ = "
+            f"{number(P[-1], 'V²')} ; estimation finale {number(x[-1], 'V')}, à "
+            f"{number(abs(x[-1] - TRUE_VOLTAGE), 'V')} de la valeur vraie.")
+
+
 @register_sliders("tension-curseurs", chapter="tension-constante")
 def voltage_spec(n_steps: int = 50, per_decade: int = 2) -> SliderSpec:
     r"""La figure :math:`(\Phi, \Psi)` du chapitre au registre des figures à curseurs (même grille que
@@ -167,4 +177,5 @@ def voltage_spec(n_steps: int = 50, per_decade: int = 2) -> SliderSpec:
         time=np.arange(1, n_steps + 1, dtype=float),
         panels=voltage_panels(),
         fixed={"z": constant_voltage_measurements(n_steps)},
+        readout=voltage_readout,
     )

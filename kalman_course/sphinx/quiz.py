@@ -40,7 +40,7 @@ from docutils.parsers.rst import directives
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
-__all__ = ["setup", "QUIZ_MARKER", "QUIZ_SCRIPT", "quiz", "quiz_question"]
+__all__ = ["setup", "QUIZ_MARKER", "QUIZ_SCRIPT", "quiz", "quiz_question", "tex_to_text", "choice_text"]
 
 LOGGER = logging.getLogger(__name__)
 
@@ -137,6 +137,66 @@ class QuestionDirective(SphinxDirective):
         return self.state.document.reporter.error(f"question de quiz : {text}", line=self.lineno)
 
 
+# --------------------------------------------------------------------------- texte des réponses (lecteurs d'écran)
+
+_GREEK = {"alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "epsilon": "ε", "varepsilon": "ε", "eta": "η",
+          "theta": "θ", "kappa": "κ", "lambda": "λ", "mu": "μ", "nu": "ν", "xi": "ξ", "pi": "π", "rho": "ρ",
+          "sigma": "σ", "tau": "τ", "phi": "φ", "varphi": "φ", "chi": "χ", "psi": "ψ", "omega": "ω",
+          "Gamma": "Γ", "Delta": "Δ", "Theta": "Θ", "Lambda": "Λ", "Sigma": "Σ", "Phi": "Φ", "Psi": "Ψ",
+          "Omega": "Ω", "ell": "ℓ", "infty": "∞", "approx": "≈", "le": "≤", "leq": "≤", "ge": "≥", "geq": "≥",
+          "neq": "≠", "times": "×", "cdot": "·", "pm": "±", "to": "→", "rightarrow": "→", "in": "∈",
+          "sum": "Σ", "partial": "∂", "nabla": "∇", "top": "ᵀ", "star": "*", "mid": "|", "quad": " ",
+          "qquad": " ", "ldots": "…", "dots": "…", "lvert": "|", "rvert": "|", "lVert": "‖", "rVert": "‖"}
+_SUP = dict(zip("0123456789-+Tnik*", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺ᵀⁿⁱᵏ*"))
+_SUB = dict(zip("0123456789-+nkijmaeoxrtps", "₀₁₂₃₄₅₆₇₈₉₋₊ₙₖᵢⱼₘₐₑₒₓᵣₜₚₛ"))
+
+
+def _script(text: str, table: dict[str, str], mark: str) -> str:
+    text = text.replace(" ", "")
+    if all(c in table for c in text):
+        return "".join(table[c] for c in text)
+    return f"{mark}({text})" if len(text) > 1 else f"{mark}{text}"
+
+
+def tex_to_text(tex: str) -> str:
+    r"""Une formule TeX en texte lisible par un lecteur d'écran : ``\hat x_{n}^-`` → « x̂ₙ⁻ »,
+    ``K = P^-/(P^- + R)`` → « K = P⁻/(P⁻ + R) » (le même texte que les extraits de la recherche du site)."""
+    t = tex
+    t = re.sub(r"\\(?:hat|widehat)\s*\{([^{}]*)\}|\\(?:hat|widehat)\s*(\\?[A-Za-z])",
+               lambda m: (m.group(1) or m.group(2)) + "\u0302", t)
+    t = re.sub(r"\\(?:bar|overline)\s*\{([^{}]*)\}", "\\1\u0304", t)
+    t = re.sub(r"\\tilde\s*\{([^{}]*)\}|\\tilde\s*([A-Za-z])", lambda m: (m.group(1) or m.group(2)) + "\u0303", t)
+    t = re.sub(r"\\[dt]?frac\s*\{([^{}]*)\}\s*\{([^{}]*)\}", r"(\1)/(\2)", t)
+    t = re.sub(r"\\sqrt\s*\{([^{}]*)\}", r"√(\1)", t)
+    t = re.sub(r"\\(?:mathrm|mathbf|mathcal|mathbb|text|operatorname|boldsymbol)\s*\{([^{}]*)\}", r"\1", t)
+    t = re.sub(r"\\(left|right|big|Big|bigl|bigr|Bigl|Bigr)\b", "", t)
+    t = re.sub(r"\\([A-Za-z]+)", lambda m: _GREEK.get(m.group(1), ""), t)
+    t = re.sub(r"\^\{([^{}]*)\}|\^(\S)", lambda m: _script(m.group(1) if m.group(1) is not None else m.group(2),
+                                                           _SUP, "^"), t)
+    t = re.sub(r"_\{([^{}]*)\}|_(\S)", lambda m: _script(m.group(1) if m.group(1) is not None else m.group(2),
+                                                         _SUB, "_"), t)
+    t = re.sub(r"\\[,;:!]", " ", t).replace("{", "").replace("}", "").replace("\\\\", " ").replace("\\", "")
+    return " ".join(t.split())
+
+
+def choice_text(node) -> str:
+    """Le texte d'une réponse proposée, formules comprises (écrites par :func:`tex_to_text`)."""
+    parts = []
+    for child in node.findall(lambda n: isinstance(n, (nodes.Text, nodes.math))):
+        if isinstance(child, nodes.math):
+            parts.append(tex_to_text(child.astext()))
+        elif not any(isinstance(a, nodes.math) for a in _ancestors(child, node)):
+            parts.append(child.astext())
+    return " ".join("".join(parts).split())
+
+
+def _ancestors(child, stop):
+    parent = child.parent
+    while parent is not None and parent is not stop:
+        yield parent
+        parent = parent.parent
+
+
 # --------------------------------------------------------------------------- numérotation
 
 
@@ -162,12 +222,17 @@ QUIZ_SCRIPT = r"""
     ".kc-quiz-question legend{font-weight:600;font-size:.95em;padding:0}" +
     ".kc-quiz-choice{display:block;margin:.2em 0;cursor:pointer}" +
     ".kc-quiz-choice input{margin-right:.5em}" +
-    ".kc-quiz-check{margin:.4em 0;padding:.2em .9em;border:1px solid #888;border-radius:4px;background:#f6f8fa;cursor:pointer}" +
+    ".kc-quiz-check{margin:.4em 0;padding:.2em .9em;border:1px solid var(--pst-color-border,#888);" +
+    "border-radius:4px;background:var(--pst-color-surface,#f6f8fa);color:var(--pst-color-text-base,#222);cursor:pointer}" +
+    ".kc-quiz-check:hover{background:var(--pst-color-on-surface,#eaeef2)}" +
     ".kc-quiz-feedback{font-weight:600;margin:.2em 0}" +
     ".kc-quiz-right .kc-quiz-feedback{color:#1a7f37}" +
     ".kc-quiz-wrong .kc-quiz-feedback{color:#cf222e}" +
     ".kc-quiz-explanation{margin:.3em 0 .2em 0}" +
-    ".kc-quiz-explanation summary{cursor:pointer;color:#0969da}";
+    ".kc-quiz-explanation summary{cursor:pointer;color:var(--pst-color-link,#0969da)}" +
+    "html[data-theme=dark] .kc-quiz-right .kc-quiz-feedback{color:#3fb950}" +
+    "html[data-theme=dark] .kc-quiz-wrong .kc-quiz-feedback{color:#ff7b72}" +
+    ".kc-quiz{border-color:var(--pst-color-border,#d0d7de)}.kc-quiz-question{border-top-color:var(--pst-color-border-muted,#eaeef2)}";
   var style = document.createElement("style");
   style.textContent = css;
   document.head.appendChild(style);
@@ -235,8 +300,10 @@ def depart_choices_html(self, node):
 
 def visit_choice_html(self, node):
     qid = node.parent.parent["qid"]
-    self.body.append(f'<label class="kc-quiz-choice"><input type="radio" name="{qid}" value="{node["index"]}">'
-                     '<span>')
+    # nom accessible explicite : une réponse faite d'une formule n'a pas de texte pour les outils
+    label = f"Réponse {_LETTERS[node['index'] - 1]} : {choice_text(node)}"
+    self.body.append(f'<label class="kc-quiz-choice"><input type="radio" name="{qid}" value="{node["index"]}" '
+                     f'aria-label="{self.attval(label)}"><span>')
 
 
 def depart_choice_html(self, node):

@@ -1,0 +1,972 @@
+"""Chaque promesse des encadrés « À observer » est vérifiée sur la grille précalculée de sa figure.
+
+Un encadré « À observer » dit à l'étudiant où mettre les curseurs et ce qu'il verra. Chaque essai de
+chaque encadré (un élément de liste, hors explications) a ici un test, inscrit par ``@promise(page,
+encadré, essai)`` : il lit la grille de la figure (``kc.interactive.slider_grid``, exactement les
+séries que la page publiée affiche) aux positions que l'encadré nomme et vérifie ce que le texte
+annonce (le pic existe, le point est dans l'axe, la part est celle du texte, la bande se voit).
+:func:`test_every_observation_item_has_a_test` vérifie qu'aucun essai des chapitres n'est sans test,
+et qu'aucun test ne vise un essai disparu.
+
+Les références sont indépendantes de la figure quand c'est possible (formes closes écrites ici, lois
+de scipy) ; sinon le test confronte deux positions des curseurs, comme le fait l'étudiant.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.stats
+
+import kalman_course.interactive as ki
+
+ROOT = Path(__file__).resolve().parent.parent
+BOOK = ROOT / "book"
+
+#: (page, n° de l'encadré dans la page, n° de l'essai) → test
+PROMISES: dict[tuple[str, int, int], object] = {}
+
+
+def promise(page: str, box: int, item: int):
+    """Inscrit un test comme la vérification de l'essai ``item`` de l'encadré n° ``box`` de ``page``."""
+
+    def decorator(func):
+        key = (page, box, item)
+        assert key not in PROMISES, f"essai {key} vérifié deux fois"
+        PROMISES[key] = func
+        return func
+
+    return decorator
+
+
+# --------------------------------------------------------------------------- lecture de la grille
+
+
+def _index_of(axis, value) -> int:
+    """Position du curseur : ``"min"``, ``"max"``, ``"default"`` ou la valeur affichée (à 2 % près : le
+    texte écrit « 1,58 » pour 1,5811…)."""
+    if value == "min":
+        return 0
+    if value == "max":
+        return axis.values.size - 1
+    if value == "default":
+        return axis.default
+    values = np.asarray(axis.values, dtype=float)
+    target = float(value)
+    k = int(np.argmin(np.abs(values - target)))
+    tolerance = 0.02 * max(abs(target), 1e-300) if target != 0 else 1e-12
+    assert abs(values[k] - target) <= tolerance, (
+        f"« {axis.name} » = {value} n'est pas une position du curseur ({', '.join(axis.labels())})")
+    return k
+
+
+def position(name: str, **values) -> tuple[int, ...]:
+    """Le point de grille de la figure ``name`` où les curseurs nommés ont ces valeurs (les autres à
+    leur position par défaut). Pour un axe dont les valeurs portent un décalage (κ de l'UKF), donner la
+    valeur de la grille."""
+    grid = ki.slider_grid(name)
+    names = [a.name for a in grid.axes]
+    unknown = set(values) - set(names)
+    assert not unknown, f"{name} : curseurs inconnus {unknown} (curseurs : {names})"
+    return tuple(_index_of(a, values.get(a.name, "default")) for a in grid.axes)
+
+
+def at(name: str, **values) -> dict[str, np.ndarray]:
+    """Les séries affichées par la figure ``name`` quand les curseurs ont ces valeurs (séries fixes comprises)."""
+    spec = ki.slider_spec(name)
+    grid = spec.grid()
+    return {"t": np.asarray(grid.time), **{k: np.asarray(v) for k, v in spec.fixed.items()},
+            **grid.run(*position(name, **values))}
+
+
+def readout(name: str, **values) -> str:
+    """Le texte affiché sous les curseurs à cette position."""
+    return ki.slider_spec(name).text_at(*position(name, **values))
+
+
+def y_axis(name: str, panel: int, **values) -> tuple[float, float]:
+    """Les bornes de l'ordonnée du panneau n° ``panel`` (à partir de 0) à cette position, telles que la
+    page les affiche."""
+    return _static(name).y_range_at(panel, *position(name, **values))
+
+
+_STATIC: dict[str, object] = {}
+
+
+def _static(name: str):
+    if name not in _STATIC:
+        _STATIC[name] = ki.slider_spec(name).static()
+    return _STATIC[name]
+
+
+def rms(v) -> float:
+    v = np.asarray(v, dtype=float)
+    v = v[np.isfinite(v)]
+    return float(np.sqrt(np.mean(v ** 2)))
+
+
+def lag1(v) -> float:
+    """Autocorrélation empirique au retard 1 (paires de valeurs finies consécutives)."""
+    v = np.asarray(v, dtype=float)
+    a, b = v[:-1], v[1:]
+    ok = np.isfinite(a) & np.isfinite(b)
+    return float(np.corrcoef(a[ok], b[ok])[0, 1])
+
+
+def roughness(v) -> float:
+    """Rugosité d'une courbe : écart quadratique moyen de sa dérivée seconde discrète."""
+    return rms(np.diff(np.asarray(v, dtype=float), 2))
+
+
+# --------------------------------------------------------------------------- les encadrés des chapitres
+
+_BOX = re.compile(r"^(:{3,4})\{admonition\} À observer\n:class: \w+\n(.*?)\n\1\s*$", re.M | re.S)
+_EXPLANATIONS = re.compile(r"(```|:::)\{dropdown\}.*?\n\s*\1|:::\{admonition\}[^\n]*\n:class: dropdown.*?\n:::|"
+                           r"```\{dropdown\}.*?\n```", re.S)
+
+
+def observation_items() -> dict[tuple[str, int, int], str]:
+    """Les essais de tous les encadrés « À observer » du livre : (page, encadré, essai) → texte."""
+    out = {}
+    for path in sorted(BOOK.glob("*.md")):
+        for b, box in enumerate(_BOX.finditer(path.read_text()), start=1):
+            trials = _EXPLANATIONS.sub("", box.group(2))
+            items = re.findall(r"^(?:\d+\.|-) (.*(?:\n(?!\s*$)(?!\d+\. |- ).*)*)", trials, re.M)
+            for i, text in enumerate(items, start=1):
+                out[(path.stem, b, i)] = " ".join(text.split())
+    return out
+
+
+def test_every_observation_item_has_a_test():
+    items = observation_items()
+    assert len(items) >= 50, f"seulement {len(items)} essais trouvés : l'analyse des encadrés a changé ?"
+    missing = sorted(set(items) - set(PROMISES))
+    extra = sorted(set(PROMISES) - set(items))
+    assert not missing, "essais « À observer » sans test :\n" + "\n".join(f"{k} : {items[k][:90]}" for k in missing)
+    assert not extra, f"tests d'essais disparus des chapitres : {extra}"
+
+
+def test_one_observation_box_per_slider_figure_right_after_it():
+    """Chaque figure à curseurs a son encadré « À observer », juste après elle (avant la figure suivante)."""
+    call = re.compile(r'kc\.interactive\.sliders\("([^"]+)"\)')
+    for path in sorted(BOOK.glob("*.md")):
+        text = path.read_text()
+        shown = [(m.start(), m.group(1)) for m in call.finditer(text)]
+        boxes = [m.start() for m in _BOX.finditer(text)]
+        for k, (start, name) in enumerate(shown):
+            end = shown[k + 1][0] if k + 1 < len(shown) else len(text)
+            inside = [b for b in boxes if start < b < end]
+            assert len(inside) == 1, f"{path.stem} : {len(inside)} encadré(s) « À observer » pour la figure {name}"
+
+
+# --------------------------------------------------------------------------- les axes suivent les données
+
+
+@pytest.mark.parametrize("name", ki.slider_names())
+def test_every_panel_shows_the_series_that_set_its_range(name):
+    """À chaque point de la grille, les séries qui fixent l'ordonnée d'un panneau (toutes ses séries, ou
+    celles de son ``Follow``) sont dans l'axe affiché : aucun point n'en sort quand on bouge un curseur."""
+    spec = ki.slider_spec(name)
+    grid = spec.grid()
+    static = _static(name)
+    problems = []
+    for p, panel in enumerate(spec.panels):
+        for index in np.ndindex(*grid.shape):
+            (x0, x1), (y0, y1) = static.ranges_at(p, *index)
+            data = {"t": np.asarray(grid.time), **spec.fixed, **grid.run(*index)}
+            checks = [(c, sorted((y0, y1)), panel.y_log) for c in panel.range_columns()]  # un axe peut être inversé
+            if panel.own_x:  # abscisses des tracés d'un panneau qui a la sienne (plan, trajectoire)
+                checks += [(c, sorted((x0, x1)), panel.x_log) for c in panel.x_columns()]
+            for column, (lo, hi), log in checks:
+                v = np.asarray(data[column], dtype=float)
+                v = v[np.isfinite(v)]
+                if log:
+                    v = v[v > 0]
+                if v.size and (v.min() < lo - 1e-9 * abs(lo) or v.max() > hi + 1e-9 * abs(hi)):
+                    problems.append(f"panneau « {panel.title} », {column} ∈ [{v.min():.4g} ; {v.max():.4g}] hors "
+                                    f"de l'axe [{lo:.4g} ; {hi:.4g}] au point {index}")
+                    break
+    assert not problems, "\n".join(problems[:10])
+
+
+# =========================================================================== introduction
+
+
+@promise("intro", 1, 1)
+def _intro_noisier_sensor():
+    base, noisy = at("intro-chariot"), at("intro-chariot", R="max")
+    # les croix s'écartent de la position vraie…
+    assert rms(noisy["y_rel"] - noisy["truth_rel"]) > 2.5 * rms(base["y_rel"] - base["truth_rel"])
+    # … mais l'estimation reste lisse, et bien plus proche de la vérité que les mesures
+    assert roughness(noisy["x_rel"]) < 0.25 * roughness(noisy["y_rel"])
+    axis = ki.slider_grid("intro-chariot").axes[0]
+    for R in axis.values[axis.default:]:  # en augmentant R, le filtre reste nettement meilleur
+        run = at("intro-chariot", R=R)
+        assert run["rmse_x"][0] < 0.75 * run["rmse_y"][0], f"R = {R}"
+    text = readout("intro-chariot", R="max")
+    assert "mesures" in text and "filtre de Kalman" in text
+
+
+@promise("intro", 1, 2)
+def _intro_unpredictable_motion():
+    base, wild = at("intro-chariot"), at("intro-chariot", Q="max")
+    assert np.ptp(wild["truth_rel"]) > 2 * np.ptp(base["truth_rel"])  # loin de la vitesse constante
+    assert rms(wild["x_rel"] - wild["y_rel"]) < rms(base["x_rel"] - base["y_rel"])  # suit les mesures
+    assert np.mean(wild["upper_rel"] - wild["lower_rel"]) > 1.3 * np.mean(base["upper_rel"] - base["lower_rel"])
+
+
+@promise("intro", 1, 3)
+def _intro_ratio_matters():
+    smooth = at("intro-chariot", R=10.0, Q=0.005)
+    follow = at("intro-chariot", R=0.1, Q=5.0)
+    assert roughness(smooth["x_rel"]) < 0.15 * roughness(smooth["y_rel"])  # lisse fortement
+    # recopie presque les mesures : l'écart estimation – mesure est petit devant le bruit (√R)
+    assert rms(follow["x_rel"] - follow["y_rel"]) < 0.3 * math.sqrt(0.1)
+
+
+# =========================================================================== le filtre en images
+
+
+@promise("intuition", 1, 1)
+def _intuition_precise_measurement():
+    run = at("intuition-produit", meas_var="min")
+    R = float(ki.slider_grid("intuition-produit").axes[1].values[0])
+    assert run["K"][0] > 0.95
+    assert abs(run["P_post"][0] - R) < 0.05 * R  # P ≈ R
+    assert abs(run["x_post"][0] - 13.0) < 0.1  # collée à la mesure y = 13 m
+    # la densité a posteriori, haute et étroite, est dans l'axe affiché
+    assert run["posterior"].max() <= y_axis("intuition-produit", 0, meas_var="min")[1]
+
+
+@promise("intuition", 1, 2)
+def _intuition_confident_prior():
+    run = at("intuition-produit", meas_var=1.0, prior_var="min")
+    assert run["K"][0] < 0.1  # le gain devient petit
+    assert abs(run["x_post"][0] - 10.0) < 0.1 * abs(13.0 - 10.0)  # l'estimation reste près de 10 m
+    # le point glisse vers le bas de la courbe K(P⁻) : c'est le plus petit gain de la courbe tracée
+    P = run["P_now"][0]
+    assert run["K"][0] == pytest.approx(P / (P + 1.0))
+    assert run["K"][0] == pytest.approx(np.interp(P, run["P_curve"], run["gain_curve"]), rel=1e-3)  # sur la courbe
+    assert run["K"][0] < at("intuition-produit", meas_var=1.0)["K"][0] / 5
+
+
+@promise("intuition", 1, 3)
+def _intuition_equal_information():
+    run = at("intuition-produit", prior_var=4.0, meas_var=4.0)
+    assert run["K"][0] == pytest.approx(0.5)
+    assert run["x_post"][0] == pytest.approx(11.5)
+    assert run["P_post"][0] == pytest.approx(2.0)
+    # partout, les points noirs (produit normalisé numériquement) sont sur la courbe bleue
+    grid = ki.slider_grid("intuition-produit")
+    for index in np.ndindex(*grid.shape):
+        r = grid.run(*index)
+        np.testing.assert_allclose(r["product"], r["posterior"][::5], atol=2e-3 * r["posterior"].max())
+
+
+@promise("intuition", 2, 1)
+def _intuition_cycle_step_by_step():
+    grid = ki.slider_grid("intuition-cycle")
+    prev = None
+    for k in range(grid.shape[0]):
+        run = at("intuition-cycle", stage=k)
+        if prev is not None:
+            if k % 2 == 1:  # prédiction : avance et s'élargit, pas de mesure
+                assert run["mean_now"][0] > prev["mean_now"][0]
+                assert run["var_now"][0] > prev["var_now"][0]
+                assert np.isnan(run["likelihood"]).all()
+            else:  # correction : la vraisemblance apparaît, la loi se resserre entre les deux
+                assert np.isfinite(run["likelihood"]).all()
+                assert run["var_now"][0] < prev["var_now"][0]
+                lo, hi = sorted((prev["mean_now"][0], run["y_now"][0]))
+                assert lo <= run["mean_now"][0] <= hi
+        prev = run
+
+
+@promise("intuition", 2, 2)
+def _intuition_cycle_regular_motion():
+    grid = ki.slider_grid("intuition-cycle")
+    q = float(grid.axes[1].values[0])
+    std = at("intuition-cycle", Q="min")["std"]
+    var = std ** 2
+    corrections = var[2::2]
+    assert np.all(np.diff(corrections) < 0)  # chaque mesure réduit la variance un peu plus
+    assert np.all(var[1::2][1:] - var[2::2][:-1] == pytest.approx(q))  # la prédiction n'ajoute que Q
+    assert q < 0.05 * corrections[-1]  # … presque rien
+    gains = corrections / 1.0  # K = P / R (R = 1 m²)
+    assert np.all(np.diff(gains) < 0)  # le gain diminue
+
+
+@promise("intuition", 2, 3)
+def _intuition_cycle_unpredictable_motion():
+    std = at("intuition-cycle", Q="max")["std"]
+    after_correction = std[2::2]
+    assert np.all((after_correction > 0.85) & (after_correction < 1.0))  # proche de √R = 1 m
+
+
+# =========================================================================== contrôle d'un système
+
+
+@promise("controle-systeme", 1, 1)
+def _system_perfect_model():
+    from kalman_course.scenarios.engine import ENGINE_PSI, engine_commands, engine_model
+
+    still = at("systeme-bruits", phi_scale=0.0)
+    model = engine_model()
+    u = np.asarray(engine_commands(still["t"].size), dtype=float).reshape(still["t"].size, -1)
+    x, states = np.zeros(2), []
+    for k in range(still["t"].size):  # xₙ₊₁ = A xₙ + B uₙ, sans bruit, écrit ici
+        x = np.asarray(model.A) @ x + np.asarray(model.B) @ u[k]
+        states.append(x)
+    states = np.array(states)
+    np.testing.assert_allclose(still["theta_m"], states[:, 0], rtol=1e-10, atol=1e-10)  # réponse déterministe
+    np.testing.assert_allclose(still["theta_a"], states[:, 1], rtol=1e-10, atol=1e-10)
+    # les mesures restent bruitées : yₙ − C xₙ a l'écart-type de ψ
+    noise = still["y1"] - (states @ np.asarray(model.C).T)[:, 0]
+    assert np.std(noise) == pytest.approx(math.sqrt(ENGINE_PSI[0, 0]), rel=0.25)
+
+
+@promise("controle-systeme", 1, 2)
+def _system_poor_sensor():
+    grid = ki.slider_grid("systeme-bruits")
+    base = at("systeme-bruits", psi_scale="min")
+    spreads = []
+    for psi in grid.axes[1].values:
+        run = at("systeme-bruits", psi_scale=psi)
+        np.testing.assert_array_equal(run["theta_m"], base["theta_m"])  # l'état ne bouge pas
+        spreads.append(roughness(run["y1"]))
+    assert np.all(np.diff(spreads) > 0) and spreads[-1] > 3 * spreads[0]  # les mesures s'éparpillent
+
+
+@promise("controle-systeme", 1, 3)
+def _system_poor_dynamics():
+    still = at("systeme-bruits", phi_scale=0.0)
+    deviations = [rms(at("systeme-bruits", phi_scale=k)["theta_m"] - still["theta_m"]) for k in (0.5, 1.0, 4.0)]
+    assert deviations[0] < deviations[1] < deviations[2]  # l'état devient erratique
+    wild = at("systeme-bruits", phi_scale=4.0)
+    d = wild["theta_m"] - still["theta_m"]
+    assert rms(d[-40:]) > 1.5 * rms(d[:40])  # le bruit d'état s'accumule au fil des pas
+    # les mesures suivent l'état : elles s'écartent de la même façon
+    assert np.corrcoef(d, wild["y1"] - still["y1"])[0, 1] > 0.8
+
+
+# =========================================================================== construction d'un estimateur
+
+
+@promise("estimateur", 1, 1)
+def _estimator_printed_condition():
+    for K in ki.slider_grid("estimateur-gain").axes[0].values:
+        run = at("estimateur-gain", K=K, A=2.0)
+        decreasing = run["recursion"][-1] < run["recursion"][0]
+        assert decreasing == (0.5 < K < 1.5), f"K = {K}"
+        if 0 < K < 2:
+            assert run["printed_now"][0] < 1  # la condition imprimée accepte tous ces gains
+
+
+@promise("estimateur", 1, 2)
+def _estimator_copy_the_measurement():
+    run = at("estimateur-gain", K=1.0, A=2.0)
+    floor = ki.estimator.FLOOR
+    assert np.all(run["recursion"][1:] == floor)  # nulle dès le premier pas : tracée au plancher
+    lo, hi = y_axis("estimateur-gain", 0, K=1.0, A=2.0)
+    assert lo <= floor / 10 and hi > 1  # le plancher est dans l'axe, une décade au-dessus du bas
+    mc = run["monte_carlo"][1:]
+    assert np.all(mc > floor) and mc.max() < 0.05  # petite devant l'erreur initiale 1, mais pas nulle
+
+
+@promise("estimateur", 1, 3)
+def _estimator_stable_system():
+    rec = at("estimateur-gain", K=0.0, A=0.5)["recursion"]
+    above = rec > ki.estimator.FLOOR
+    np.testing.assert_allclose(rec[1:][above[1:]] / rec[:-1][above[1:]], 0.5, rtol=1e-12)
+    for A in (2.0, 3.0):  # un système instable : trop peu de gain, l'erreur explose
+        assert at("estimateur-gain", K=0.0, A=A)["recursion"][-1] > 1e3
+
+
+# =========================================================================== prédicteur–correcteur
+
+
+@promise("predicteur-correcteur", 1, 1)
+def _predictor_step_by_step():
+    std = at("predicteur-etapes", stage=0)["std"]
+    assert std[0] == pytest.approx(15.0)  # P₀ = 15² I °C² : presque plate
+    assert std[2] < std[0] / 10  # la première correction resserre d'un coup
+    assert np.all(std[1::2][1:] > std[2::2][:-1])  # chaque prédiction élargit…
+    assert np.all(std[2::2] < std[1::2])  # … chaque correction resserre (dents de scie)
+    first = at("predicteur-etapes", stage=2)
+    assert abs(first["mean_now"][0] - first["inverted_x"][0]) < 3 * first["std_now"][0]
+
+
+@promise("predicteur-correcteur", 1, 2)
+def _predictor_distrustful_filter():
+    careful, normal = at("predicteur-etapes", psi_scale=1e6, stage=10), at("predicteur-etapes", stage=10)
+    assert careful["gain_norm"][0] < 0.01 * normal["gain_norm"][0]  # K → 0
+    std = careful["std"]
+    assert np.all(std[2::2] > 0.99 * std[1::2])  # les corrections ne resserrent plus rien
+    # l'estimation reste celle du modèle, partie 15 °C trop haut
+    assert careful["mean_now"][0] - careful["truth_x"][0] > 10.0
+
+
+@promise("predicteur-correcteur", 1, 3)
+def _predictor_trusting_filter():
+    for stage in range(2, 11, 2):  # chaque correction
+        run = at("predicteur-etapes", psi_scale=1e-6, stage=stage)
+        peak = 1.0 / (math.sqrt(2 * math.pi) * run["std_now"][0])
+        top = run["current"].max()
+        assert top > 0.9 * peak, f"étape {stage} : pic {top:.3g} au lieu de {peak:.3g}"  # le pic est tracé
+        where = run["current_x"][np.argmax(run["current"])]
+        assert abs(where - run["inverted_x"][0]) < 0.01  # sur la mesure inversée (trait vert)
+        lo, hi = y_axis("predicteur-etapes", 0, psi_scale=1e-6, stage=stage)
+        assert lo == 0 and top <= hi <= 1.2 * top  # le pic est dans l'axe, qui s'y ajuste
+        assert abs(run["mean_now"][0] - run["inverted_x"][0]) < 1e-3  # recopie la mesure
+
+
+# =========================================================================== gain optimal
+
+
+def _voltage_psi() -> float:
+    return float(__import__("kalman_course").scenarios.constant_voltage_model().R[0, 0])
+
+
+@promise("gain-optimal", 1, 1)
+def _gain_minimum():
+    psi = _voltage_psi()
+    grid = ki.slider_grid("gain-trace")
+    n10 = at("gain-trace", n=10.0)
+    K_star, P_pred = n10["K_star"][0], n10["P_pred"][0]
+    assert K_star == pytest.approx(P_pred / (P_pred + psi), rel=1e-12)
+    for K in grid.axes[1].values:
+        run = at("gain-trace", n=10.0, K=K)
+        # P(K) − P(K*) = (K − K*)² S, S = P⁻ + Ψ (l'identité du carré complété)
+        assert run["P_now"][0] - run["P_star"][0] == pytest.approx((K - K_star) ** 2 * (P_pred + psi),
+                                                                   rel=1e-9, abs=1e-15)
+
+
+@promise("gain-optimal", 1, 2)
+def _gain_two_terms():
+    run = at("gain-trace", n=10.0)
+    K = run["t"]
+    np.testing.assert_allclose(run["prediction"], (1 - K) ** 2, rtol=1e-12)
+    np.testing.assert_allclose(run["measurement"], K ** 2 * _voltage_psi() / run["P_pred"][0], rtol=1e-12)
+    # au gain de Kalman, les pentes des deux termes sont opposées
+    k = run["K_star"][0]
+    slope_prediction = -2 * (1 - k)
+    slope_measurement = 2 * k * _voltage_psi() / run["P_pred"][0]
+    assert slope_prediction + slope_measurement == pytest.approx(0.0, abs=1e-12)
+    # la courbe tracée a son minimum au gain de Kalman (au pas de la courbe près)
+    assert abs(K[np.argmin(run["total"])] - k) <= (K[1] - K[0])
+
+
+@promise("gain-optimal", 1, 3)
+def _gain_decreases_with_time():
+    first, late = at("gain-trace", n=1.0), at("gain-trace", n=50.0)
+    assert first["P_pred"][0] == pytest.approx(1.0, rel=0.01)  # P⁻₁ ≈ 1 V²
+    assert first["K_star"][0] > 0.98
+    assert 0.01 < late["K_star"][0] < 0.1  # quelques centièmes
+
+
+# =========================================================================== tension constante
+
+
+@promise("tension-constante", 1, 1)
+def _voltage_bad_sensor():
+    base, bad = at("tension-curseurs"), at("tension-curseurs", R="max")
+    assert bad["K"][:10].mean() < base["K"][:10].mean() / 20  # le gain s'effondre
+    assert roughness(bad["x"]) < roughness(base["x"])  # lisse…
+    truth = -0.37727  # valeur vraie du chapitre
+    assert abs(bad["x"][9] - truth) > 5 * abs(base["x"][9] - truth)  # … mais lente à rejoindre la vraie valeur
+
+
+@promise("tension-constante", 1, 2)
+def _voltage_unstable_voltage():
+    base, wild = at("tension-curseurs"), at("tension-curseurs", Q="max")
+    assert wild["P"][-1] > 10 * base["P"][-1]  # Pₙ ne descend plus beaucoup
+    assert wild["K"][-1] > 0.5  # le gain reste grand
+    assert rms(wild["x"] - wild["z"]) < 0.5 * rms(base["x"] - base["z"])  # suit les mesures de près
+
+
+@promise("tension-constante", 1, 3)
+def _voltage_riccati_ignores_the_data():
+    # Pₙ et Kₙ de chaque exécution = la récurrence de Riccati scalaire écrite ici, sans aucune mesure
+    grid = ki.slider_grid("tension-curseurs")
+    for i, j in np.ndindex(*grid.shape):
+        Q, R = grid.values_at(i, j)
+        run = grid.run(i, j)
+        P, Ps, Ks = 1.0, [], []
+        for _ in range(grid.time.size):
+            Pp = P + Q
+            K = Pp / (Pp + R)
+            P = (1 - K) * Pp
+            Ps.append(P)
+            Ks.append(K)
+        np.testing.assert_allclose(run["P"], Ps, rtol=1e-9)
+        np.testing.assert_allclose(run["K"], Ks, rtol=1e-9)
+
+
+# =========================================================================== pratique et synthèse
+
+
+def _practice(true_std, assumed_std):
+    run = at("pratique-capteur", true_std=true_std, assumed_std=assumed_std)
+    v = run["normalised"]
+    inside = np.mean(np.abs(run["error"]) <= run["upper"])
+    return run, float(v.std()), float(np.mean(np.abs(v) > 2)), float(inside)
+
+
+@promise("pratique-synthese", 1, 1)
+def _practice_optimistic_maker():
+    run, std, outside, inside = _practice(1.58, 0.5)
+    assert std > 2 and outside > 0.3  # bien plus souvent hors de ±2
+    assert inside < 0.7  # l'erreur déborde de la bande
+    lo, hi = y_axis("pratique-capteur", 0, true_std=1.58, assumed_std=0.5)
+    assert lo <= run["normalised"].min() and run["normalised"].max() <= hi  # les innovations restent dans l'axe
+
+
+@promise("pratique-synthese", 1, 2)
+def _practice_cautious_filter():
+    run, std, outside, inside = _practice(0.5, 1.58)
+    good, _, _, good_inside = _practice(0.5, 0.5)
+    assert std < 0.5 and outside == 0  # innovations bien trop petites, aucune hors de ±2
+    assert inside > 0.98 > good_inside  # presque toute l'erreur dans la bande (99 % au lieu de 95 %)
+    # la bande n'est qu'un peu trop large : l'erreur a grandi avec elle (le filtre lisse trop)
+    assert rms(run["error"]) > 1.2 * rms(good["error"])
+    ratio = np.mean(run["upper"] / 2) / rms(run["error"])
+    assert 1.0 < ratio < 1.6
+    assert "99,2\u00a0% des instants" in readout("pratique-capteur", true_std=0.5, assumed_std=1.58)
+
+
+@promise("pratique-synthese", 1, 3)
+def _practice_agreement_not_level():
+    run, std, outside, inside = _practice(5.0, 5.0)
+    assert 0.8 < std < 1.25 and 0.02 < outside < 0.1  # environ 5 % hors de ±2
+
+
+# =========================================================================== tests statistiques
+
+
+def _band():
+    from kalman_course.diagnostics.consistency import chi2_band
+    from kalman_course.scenarios.engine import CONSISTENCY_MC_RUNS
+
+    return chi2_band(2, CONSISTENCY_MC_RUNS)
+
+
+@promise("tests-statistiques", 1, 1)
+def _consistency_optimistic():
+    lo, hi = _band()
+    run = at("tests-nees-nis", psi_factor=0.1)
+    assert run["nees"][10:].mean() > 2 * hi and run["nis"][10:].mean() > 2 * hi
+
+
+@promise("tests-statistiques", 1, 2)
+def _consistency_pessimistic():
+    lo, hi = _band()
+    run = at("tests-nees-nis", psi_factor=1.0, phi_factor=10.0)
+    assert run["nees"][10:].mean() < lo and run["nis"][10:].mean() < lo
+
+
+@promise("tests-statistiques", 1, 3)
+def _consistency_scale():
+    base, scaled = at("tests-nees-nis"), at("tests-nees-nis", phi_factor=10.0, psi_factor=10.0)
+    for key in ("nees", "nis"):
+        ratio = scaled[key][10:].mean() / base[key][10:].mean()
+        assert 0.08 < ratio < 0.12, f"{key} : rapport {ratio:.3f}"  # le dixième
+
+
+# =========================================================================== EKF
+
+
+@promise("ekf", 1, 1)
+def _ekf_small_uncertainty():
+    run = at("ekf-linearisation-curseurs", bearing_std_deg=2.5)
+    size = np.ptp(run["exact_y"])
+    gap = np.hypot(run["exact_mean_x"] - run["ekf_mean_x"], run["exact_mean_y"] - run["ekf_mean_y"])[0]
+    assert gap < 0.01 * size  # les deux ellipses se confondent
+    assert np.ptp(run["ekf_y"]) == pytest.approx(size, rel=0.02)
+
+
+@promise("ekf", 1, 2)
+def _ekf_large_uncertainty():
+    for deg in (45.0, 60.0):
+        run = at("ekf-linearisation-curseurs", bearing_std_deg=deg)
+        s = math.radians(deg)
+        # environ r̂ e^{-σ²/2} (la moyenne « exacte » de la figure est celle de 2 000 tirages)
+        assert run["exact_mean_x"][0] == pytest.approx(10.0 * math.exp(-s * s / 2), rel=0.03)
+        assert run["ekf_mean_x"][0] == pytest.approx(10.0)  # l'EKF propage f(x̂)
+        assert run["ekf_bias"][0] > 1.0
+        assert run["cloud_x"].mean() < 9.0  # le croissant recule
+
+
+@promise("ekf", 1, 3)
+def _ekf_flat_tangent():
+    grid = ki.slider_grid("ekf-linearisation-curseurs")
+    for sr in grid.axes[1].values:
+        widths = [np.ptp(at("ekf-linearisation-curseurs", bearing_std_deg=d, range_std=sr)["ekf_x"])
+                  for d in grid.axes[0].values]
+        # en x, l'ellipse de l'EKF ne dépend que de σr (largeur 2 × 2σr), pas de σθ
+        np.testing.assert_allclose(widths, 4 * sr, rtol=2e-3)
+    run = at("ekf-linearisation-curseurs", bearing_std_deg=30.0)
+    assert run["cloud_x"].max() <= 10.0 + 4 * ki.slider_grid("ekf-linearisation-curseurs").axes[1].default_value
+
+
+# =========================================================================== suivi du tag
+
+
+@promise("suivi-tag", 1, 1)
+def _tag_overconfident():
+    run = at("tag-curseurs", range_std="min")
+    assert np.median(run["sigma"]) < 0.5 * np.median(run["err"])
+
+
+@promise("suivi-tag", 1, 2)
+def _tag_too_regular():
+    base, stiff = at("tag-curseurs"), at("tag-curseurs", accel_std="min")
+    assert rms(stiff["err"]) > 1.5 * rms(base["err"])
+
+
+@promise("suivi-tag", 1, 3)
+def _tag_ratio():
+    grid = ki.slider_grid("tag-curseurs")
+    i, j = grid.default_index
+    base = grid.run(i, j)
+    both = grid.run(i + 2, j + 2)  # deux crans chacun : même rapport σa/σr
+    span = np.ptp(base["px"])
+    assert rms(both["px"] - base["px"]) < 0.1 * span and rms(both["py"] - base["py"]) < 0.1 * span
+    assert np.median(both["sigma"]) > 2.5 * np.median(base["sigma"])  # l'écart-type annoncé grandit
+
+
+# =========================================================================== EKF itéré
+
+
+@promise("ekf-itere", 1, 1)
+def _iekf_iterate():
+    run = at("ekf-itere-curseurs")
+    d = run["distance"]
+    assert 0.4 < d[1] < 1.0  # l'EKF tombe à environ 0,7 m du MAP
+    assert d[2] < 0.1 * d[1] and d[3] < 0.01 * d[2]  # chute de plusieurs ordres de grandeur par pas
+    assert d[-1] < 1e-9  # jusqu'au seuil d'arrêt
+
+
+@promise("ekf-itere", 1, 2)
+def _iekf_confident_wrong_prior():
+    from kalman_course.scenarios.radar_prior import radar_problem_with_prior
+
+    run = at("ekf-itere-curseurs", prior_std=0.3)
+    truth = np.array([run["truth_x"][0], run["truth_y"][0]])
+    assert np.linalg.norm(radar_problem_with_prior(0.3).x_pred - truth) > 3.0  # l'a priori, à plus de 3 m
+    map_to_truth = np.hypot(run["map_x"][0] - truth[0], run["map_y"][0] - truth[1])
+    assert 0.3 < map_to_truth < 0.5  # le MAP reste à environ 40 cm
+    assert run["distance"][-1] < 1e-9  # l'EKF itéré converge vers le MAP
+
+
+@promise("ekf-itere", 1, 3)
+def _iekf_vague_prior():
+    run = at("ekf-itere-curseurs", prior_std=30.0)
+    map_to_truth = np.hypot(run["map_x"][0] - run["truth_x"][0], run["map_y"][0] - run["truth_y"][0])
+    ekf_to_truth = np.hypot(run["ekf_x"][0] - run["truth_x"][0], run["ekf_y"][0] - run["truth_y"][0])
+    assert 0.1 < map_to_truth < 0.3  # une vingtaine de centimètres (le bruit du capteur)
+    assert ekf_to_truth > 3 * map_to_truth  # l'EKF reste loin
+
+
+# =========================================================================== UKF
+
+
+def _ellipse_area(x, y) -> float:
+    return 0.5 * abs(np.dot(x, np.roll(y, 1)) - np.dot(y, np.roll(x, 1)))
+
+
+def _inside_ellipse(px, py, ex, ey) -> np.ndarray:
+    from matplotlib.path import Path as MplPath
+
+    return MplPath(np.column_stack([ex, ey])).contains_points(np.column_stack([px, py]))
+
+
+@promise("ukf", 1, 1)
+def _ukf_small_bearing_uncertainty():
+    small = at("ukf-banane-incertitude", bearing_std=2.5)
+    size = np.ptp(small["truth_x"])
+    truth_area = _ellipse_area(small["truth_x"], small["truth_y"])
+    for method in ("lin", "ut"):  # les ellipses se confondent : même centre, même aire, même largeur
+        gap = np.hypot(small[f"{method}_mx"][0] - small["truth_mx"][0], small[f"{method}_my"][0] - small["truth_my"][0])
+        assert gap < 0.01 * size, method
+        assert _ellipse_area(small[f"{method}_x"], small[f"{method}_y"]) == pytest.approx(truth_area, rel=0.03), method
+        assert np.ptp(small[f"{method}_x"]) == pytest.approx(size, rel=0.01), method
+
+
+@promise("ukf", 1, 2)
+def _ukf_large_bearing_uncertainty():
+    big = at("ukf-banane-incertitude", bearing_std=40.0)
+    lin_mean = np.hypot(big["lin_mx"][0], big["lin_my"][0])
+    assert lin_mean == pytest.approx(1.0)  # la moyenne linéarisée reste sur l'arc, à 1 m…
+    assert big["truth_my"][0] < 0.85  # … loin de la moyenne vraie du nuage
+    ut_gap = np.hypot(big["ut_mx"][0] - big["truth_mx"][0], big["ut_my"][0] - big["truth_my"][0])
+    assert ut_gap < 0.03  # l'UKF suit la moyenne (à moins de 3 cm)
+    inside = _inside_ellipse(big["cloud_x"], big["cloud_y"], big["ut_x"], big["ut_y"]).mean()
+    assert inside > 0.9  # et son ellipse englobe le nuage
+    # l'ellipse de l'EKF n'a que l'épaisseur radiale de σr : 2 × 2σr = 8 cm
+    sr = ki.slider_grid("ukf-banane-incertitude").axes[1].default_value
+    assert np.ptp(big["lin_y"]) == pytest.approx(4 * sr, rel=0.01)
+    text = readout("ukf-banane-incertitude", bearing_std=40.0)
+    assert "EKF (0 ; 1) m" in text and "UKF" in text  # les moyennes se lisent sous les curseurs
+
+
+@promise("ukf", 2, 1)
+def _ukf_small_alpha():
+    tight, base = at("ukf-banane-parametres", alpha=0.1), at("ukf-banane-parametres")
+    spread = lambda r: np.hypot(r["sig_x"] - r["ut_mx"], r["sig_y"] - r["ut_my"]).max()  # noqa: E731
+    assert spread(tight) < 0.2 * spread(base)  # les points sigma se resserrent
+    assert _ellipse_area(tight["ut_x"], tight["ut_y"]) < _ellipse_area(base["ut_x"], base["ut_y"])
+
+
+@promise("ukf", 2, 2)
+def _ukf_kappa():
+    axis = ki.slider_grid("ukf-banane-parametres").axes[1]
+    base = at("ukf-banane-parametres")
+    low = at("ukf-banane-parametres", kappa=2 - 1.5)  # valeurs de la grille : n + κ, n = 2
+    high = at("ukf-banane-parametres", kappa=2 + 4.0)
+    assert axis.labels()[0].startswith("−1,5") and axis.labels()[-1].startswith("4")
+    area = lambda r: _ellipse_area(r["ut_x"], r["ut_y"])  # noqa: E731
+    assert area(high) > 1.1 * area(base)  # κ = 4 : les points voient les bouts de la banane
+    spread = lambda r: np.hypot(r["sig_x"] - r["ut_mx"], r["sig_y"] - r["ut_my"]).max()  # noqa: E731
+    assert spread(low) < spread(base) < spread(high)
+
+
+# =========================================================================== filtre particulaire
+
+
+def _pf(**values):
+    return at("filtre-particulaire-curseurs", **values)
+
+
+@promise("filtre-particulaire", 1, 1)
+def _pf_particle_count():
+    few, hundred = _pf(n_particles=10.0), _pf(n_particles=100.0)
+    assert np.mean(np.abs(few["gap"]) > few["hi"]) > 0.1  # 10 particules : sort souvent de la bande
+    assert np.abs(hundred["gap"]).max() < 0.5 * hundred["hi"].min()  # dès 100 : petit devant l'écart-type
+    ratio = rms(hundred["gap"]) / rms(_pf(n_particles=10000.0)["gap"])
+    assert 4 < ratio < 25  # en 1/√N : ×100 particules, écart divisé par environ 10
+
+
+@promise("filtre-particulaire", 1, 2)
+def _pf_precise_measurement():
+    sharp, base = _pf(R=0.01), _pf()
+    assert np.median(sharp["ess"]) < 0.7 * np.median(base["ess"])  # l'ESS relative baisse nettement
+    assert np.mean(sharp["ess"] < 0.5) > 0.8  # rééchantillonnage presque à chaque pas (ESS < N/2)
+
+
+@promise("filtre-particulaire", 1, 3)
+def _pf_more_particles():
+    big, mid = _pf(R=0.01, n_particles=10000.0), _pf(R=0.01, n_particles=1000.0)
+    assert abs(np.median(big["ess"]) - np.median(mid["ess"])) < 0.05  # l'ESS relative ne change guère
+    assert rms(big["gap"]) < 0.7 * rms(mid["gap"])  # l'écart se resserre
+    for n in (1000.0, 10000.0):  # l'axe montre la bande ±0,2 m (la moitié de sa hauteur au moins)
+        lo, hi = y_axis("filtre-particulaire-curseurs", 0, R=0.01, n_particles=n)
+        assert (hi - lo) < 4 * big["hi"].max()
+
+
+# =========================================================================== EnKF
+
+
+@promise("enkf", 1, 1)
+def _enkf_without_perturbations():
+    ratios = [at("enkf-ensemble", n_members=n, perturb=0.0)["ratio"][0]
+              for n in ki.slider_grid("enkf-ensemble").axes[0].values]
+    assert max(ratios) < 0.5  # moins de la moitié de la variance du filtre de Kalman
+    assert max(ratios) / min(ratios) < 1.5  # et ce rapport ne dépend pas de N
+
+
+@promise("enkf", 1, 2)
+def _enkf_small_ensemble():
+    def wobble(n):
+        run = at("enkf-ensemble", n_members=n, perturb=1.0)
+        return float(np.std(run["ensemble"] / run["kalman"]))
+
+    assert wobble(10.0) > 3 * wobble(800.0)
+
+
+@promise("enkf", 1, 3)
+def _enkf_large_ensemble():
+    big = at("enkf-ensemble", n_members=800.0, perturb=1.0)
+    small = at("enkf-ensemble", n_members=10.0, perturb=1.0)
+    dev = lambda r: rms(r["ensemble"] / r["kalman"] - 1)  # noqa: E731
+    assert dev(big) < 0.1  # la courbe orange se cale sur la noire
+    assert 3 < dev(small) / dev(big) < 30  # en 1/√N : √80 ≈ 9
+
+
+# =========================================================================== lissage
+
+
+def _nile(**values):
+    return at("nil-curseurs", **values)
+
+
+@promise("lissage", 1, 1)
+def _nile_frozen_level():
+    run = _nile(Q="min")
+    y = run["y"]
+    assert np.ptp(run["xs"]) < 0.02 * np.nanmean(y)  # une droite horizontale…
+    assert run["xs"].mean() == pytest.approx(np.nanmean(y), rel=0.02)  # … la moyenne de toutes les mesures
+    observed = np.isfinite(y)
+    running = np.cumsum(np.where(observed, y, 0)) / np.maximum(np.cumsum(observed), 1)
+    assert rms((run["xf"] - running)[20:]) < 0.03 * np.nanmean(y)  # une moyenne qui se stabilise
+
+
+@promise("lissage", 1, 2)
+def _nile_wild_level():
+    run = _nile(Q="max")
+    y = run["y"]
+    ok = np.isfinite(y)
+    spread = rms(y[ok] - y[ok].mean())
+    assert rms(run["xf"][ok] - y[ok]) < 0.3 * spread and rms(run["xs"][ok] - y[ok]) < 0.3 * spread
+
+
+@promise("lissage", 1, 3)
+def _nile_missing_years():
+    run = _nile()
+    y = run["y"]
+    gaps = np.flatnonzero(np.isnan(y))
+    first_gap = gaps[: np.argmax(np.diff(gaps) > 1) + 1] if np.any(np.diff(gaps) > 1) else gaps
+    a, b = first_gap[0], first_gap[-1]
+    assert np.ptp(run["xf"][a:b + 1]) < 1e-9 * run["xf"][a]  # le niveau filtré reste figé
+    assert np.all(np.diff(run["sf"][a:b + 1]) > 0)  # son écart-type grandit
+    ss = run["ss"][a:b + 1]
+    middle = int(np.argmax(ss))
+    assert 0 < middle < len(ss) - 1 and ss[middle] > 1.2 * max(ss[0], ss[-1])  # en lentille
+    lo, hi = sorted((run["xs"][a - 1], run["xs"][b + 1]))
+    assert np.all((run["xs"][a:b + 1] >= lo - 1e-6) & (run["xs"][a:b + 1] <= hi + 1e-6))  # joint les bords
+
+
+@promise("lissage", 1, 4)
+def _nile_scale_free_levels():
+    grid = ki.slider_grid("nil-curseurs")
+    i, j = grid.default_index
+    base, both = grid.run(i, j), grid.run(i + 1, j + 1)
+    assert grid.axes[0].values[i + 1] / grid.axes[0].values[i] == pytest.approx(
+        grid.axes[1].values[j + 1] / grid.axes[1].values[j])  # un cran chacun : même rapport
+    np.testing.assert_allclose(both["xf"], base["xf"], rtol=1e-8)  # les niveaux ne bougent pas
+    np.testing.assert_allclose(both["xs"], base["xs"], rtol=1e-8)
+    factor = math.sqrt(grid.axes[0].values[i + 1] / grid.axes[0].values[i])
+    np.testing.assert_allclose(both["ss"] / base["ss"], factor, rtol=1e-8)  # écarts-types × √facteur
+
+
+# =========================================================================== vraisemblance
+
+
+def _ll(**values):
+    run = at("vraisemblance-nil", **values)
+    v = run["normalised"][np.isfinite(run["normalised"])]
+    return run, v
+
+
+@promise("vraisemblance", 1, 1)
+def _likelihood_frozen_level():
+    (best, _), (run, v) = _ll(), _ll(Q="min")
+    drop = best["ll_now"][0] - run["ll_now"][0]
+    assert 20 < drop < 40  # une trentaine de nats
+    assert lag1(v) > 0.3  # innovations corrélées d'une année à l'autre
+    after = run["normalised"][run["t"] > 1899]
+    assert np.mean(after[np.isfinite(after)] < 0) > 0.6  # du même signe après la rupture
+    lo, hi = y_axis("vraisemblance-nil", 0, Q="min")
+    assert lo <= run["ll_now"][0] <= hi  # le point rouge reste dans l'axe
+
+
+@promise("vraisemblance", 1, 2)
+def _likelihood_wild_level():
+    (best, _), (run, v) = _ll(), _ll(Q="max")
+    assert v.std() < 0.6  # bien en dessous de 1
+    assert lag1(v) < -0.1  # corrélées négativement
+    assert best["ll_now"][0] - run["ll_now"][0] > 20  # la vraisemblance baisse aussi
+    lo, hi = y_axis("vraisemblance-nil", 0, Q="max")
+    assert lo <= run["ll_now"][0] <= hi
+
+
+@promise("vraisemblance", 1, 3)
+def _likelihood_scale():
+    grid = ki.slider_grid("vraisemblance-nil")
+    i, j = grid.default_index
+    best, both = grid.run(i, j), grid.run(i + 1, j + 1)
+    v = both["normalised"][np.isfinite(both["normalised"])]
+    assert v.std() < 0.8  # sous 1
+    assert 15 < best["ll_now"][0] - both["ll_now"][0] < 30  # une vingtaine de nats
+    for index in ((0, j), (grid.shape[0] - 1, j), (i, 0), (i, grid.shape[1] - 1)):  # bouts des curseurs
+        lo, hi = _static("vraisemblance-nil").y_range_at(0, *index)
+        assert lo <= grid.run(*index)["ll_now"][0] <= hi
+
+
+# =========================================================================== SRIF
+
+
+def _srif(k):
+    return at("srif-a-priori", exponent=float(k))
+
+
+@promise("srif", 1, 1)
+def _srif_small_prior():
+    run = _srif(2)
+    kf = run["kf"][np.isfinite(run["kf"])]
+    assert 1e-7 < run["raw_max"][0] < 1e-5  # de l'ordre du micromètre
+    assert kf[0] > 100 * kf[10]  # s'efface à mesure que les relevés arrivent
+    # un biais en 10⁻ᵏ : divisé par 10 à chaque cran de k jusqu'à k = 5
+    for k in (2, 3, 4):
+        assert _srif(k)["raw_max"][0] / _srif(k + 1)["raw_max"][0] == pytest.approx(10.0, rel=0.05)
+    srif = ki.slider_spec("srif-a-priori").fixed["srif"]
+    assert run["raw_max"][0] > 1e6 * np.nanmax(srif)  # bien plus que le SRIF…
+    assert run["raw_max"][0] < 1e-3  # … mais minuscule devant le bruit de mesure (1 mm)
+
+
+@promise("srif", 1, 2)
+def _srif_large_prior():
+    best = min(_srif(k)["raw_max"][0] for k in range(2, 10))
+    assert _srif(12)["failed"][0] == 1.0  # le filtre s'arrête (croix rouge)
+    assert any(_srif(k)["failed"][0] for k in range(12, 17))
+    for k in (10, 11):
+        assert _srif(k)["raw_max"][0] > 1e4 * best  # les chiffres significatifs perdus
+
+
+@promise("srif", 1, 3)
+def _srif_srif():
+    srif = ki.slider_spec("srif-a-priori").fixed["srif"]
+    assert np.nanmax(srif) < 1e-12  # à l'arrondi de la double précision
+    grid = ki.slider_grid("srif-a-priori")
+    best = np.nanmin(grid.series["raw_max"])
+    assert np.nanmax(srif) < best / 100  # mieux que le filtre de Kalman, quel que soit k
+
+
+# =========================================================================== EKF itéré sur SE(3)
+
+
+@promise("ekf-itere-se3", 1, 1)
+def _se3_iterate():
+    run = at("se3-bruit-pixels", sigma_px=1.0)
+    a, p = run["angle"], run["position"]
+    assert a[0] == pytest.approx(10.0, rel=0.01) and p[0] == pytest.approx(20.0, rel=0.01)  # 10° et 20 cm
+    assert a[1] < 0.1 * a[0] and p[1] < 0.1 * p[0]  # l'EKF en efface l'essentiel d'un coup
+    assert a[2] < a[1]  # l'itération suivante corrige encore l'orientation…
+    assert p[2] < 0.1 * p[0]  # … la position reste de l'ordre du centimètre
+    n = int(run["n_iter"][0])
+    assert np.all(a[n:] == a[n]) and n <= 8  # puis l'EKF itéré s'arrête (convergé)
+
+
+@promise("ekf-itere-se3", 1, 2)
+def _se3_noisy_pixels():
+    base, noisy = at("se3-bruit-pixels", sigma_px=1.0), at("se3-bruit-pixels", sigma_px=10.0)
+    assert 2.0 < noisy["angle"][-1] < 4.0 and 4.0 < noisy["position"][-1] < 8.0  # près de 3°, environ 6 cm
+    assert noisy["angle"][-1] > 3 * base["angle"][-1]
+    assert noisy["n_iter"][0] >= 1.5 * base["n_iter"][0]  # environ deux fois plus d'itérations
+
+
+@promise("ekf-itere-se3", 1, 3)
+def _se3_precise_pixels():
+    base, fine = at("se3-bruit-pixels", sigma_px=1.0), at("se3-bruit-pixels", sigma_px=0.1)
+    assert fine["angle"][-1] < 0.3 * base["angle"][-1] and fine["position"][-1] < 0.3 * base["position"][-1]
+
+
+# --------------------------------------------------------------------------- (en dernier : après les inscriptions)
+
+
+@pytest.mark.parametrize("key", sorted(PROMISES), ids=lambda k: f"{k[0]}-{k[1]}.{k[2]}")
+def test_promise(key):
+    PROMISES[key]()
