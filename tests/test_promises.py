@@ -964,6 +964,310 @@ def _se3_precise_pixels():
     assert fine["angle"][-1] < 0.3 * base["angle"][-1] and fine["position"][-1] < 0.3 * base["position"][-1]
 
 
+# =========================================================================== plusieurs capteurs, temps irrégulier
+
+
+def _helicopter():
+    from kalman_course.scenarios import helicopter as heli
+
+    track = heli.helicopter_track("position")
+    rows = np.asarray(track.position_rows)
+    return heli, track, rows, np.flatnonzero(rows)[list(heli.OUTLIER_ROWS)]
+
+
+@promise("capteurs-temps-irregulier", 1, 1)
+def _gate_removed():
+    _, _, _, bad = _helicopter()
+    free, gated = at("capteurs-porte-curseurs", gate=1.0), at("capteurs-porte-curseurs")
+    assert free["n_rejected"][0] == 0 and gated["n_outliers"][0] == 6  # la porte les écartait toutes
+    for j, k in enumerate(bad):  # à chaque croix rouge, l'estimation sans porte part vers elle
+        hook = 1e3 * np.array([free["est_e"][k] - gated["est_e"][k], free["est_n"][k] - gated["est_n"][k]])
+        toward = 1e3 * np.array([free["out_e"][j] - gated["est_e"][k], free["out_n"][j] - gated["est_n"][k]])
+        assert np.linalg.norm(hook) > 0.5 * np.linalg.norm(toward), f"position {k}"  # plus de la moitié du chemin
+        assert hook @ toward > 0.9 * np.linalg.norm(hook) * np.linalg.norm(toward), f"position {k}"
+
+
+@promise("capteurs-temps-irregulier", 1, 2)
+def _gate_tight():
+    _, track, rows, bad = _helicopter()
+    assert np.isnan(at("capteurs-porte-curseurs", gate=0.999)["lost"][0])  # p = 0,999 : jamais perdue
+    tight = at("capteurs-porte-curseurs", gate=0.9)
+    lost = tight["lost"][0]
+    assert 50.0 <= lost <= 60.0  # à la fin de la première minute
+    # … pendant un virage serré : le cap des positions mesurées tourne de plus de 30° entre 55 et 65 s
+    t, y = np.asarray(track.t)[rows], np.asarray(track.y)[rows]
+    heading = np.unwrap(np.arctan2(np.gradient(y[:, 1], t), np.gradient(y[:, 0], t)))
+    window = (t >= 55.0) & (t < 65.0)
+    assert abs(np.degrees(heading[window][-1] - heading[window][0])) > 30.0
+    good = rows.copy()
+    good[bad] = False
+    before = good & (np.asarray(track.t) < lost)
+    assert np.mean(np.isfinite(tight["rej_n"][before])) <= 0.1  # avant, pas plus d'une bonne mesure sur dix
+    assert tight["n_rejected"][0] > 0.5 * rows.sum()  # après, les rejets s'enchaînent
+
+
+@promise("capteurs-temps-irregulier", 1, 3)
+def _gate_small_q():
+    _, track, _, _ = _helicopter()
+    run = at("capteurs-porte-curseurs", gate=0.999, q="min")
+    q = ki.slider_grid("capteurs-porte-curseurs").axes[1]
+    assert q.values[0] == pytest.approx(q.values[q.default] / 100)  # q divisé par 100
+    lost = run["lost"][0]
+    assert lost < 15.0  # la piste part dès les premières secondes
+    t, nis = np.asarray(track.t), run["nis"]
+    ok = np.isfinite(nis)
+    assert np.median(nis[ok & (t < lost)]) < 3.0  # avant : la NIS d'un filtre qui suit (2 attendu)
+    assert np.max(nis[ok]) > 1e3  # des milliers
+    late = ok & (t > t.max() / 2)
+    assert np.median(nis[late]) > 100 * np.median(nis[ok & (t < lost)])  # et elle grimpe
+
+
+@promise("capteurs-temps-irregulier", 1, 4)
+def _gate_tight_large_q():
+    q = ki.slider_grid("capteurs-porte-curseurs").axes[1]
+    assert q.values[-1] == pytest.approx(10 * q.values[q.default])  # q multiplié par 10
+    run, base = at("capteurs-porte-curseurs", gate=0.9, q="max"), at("capteurs-porte-curseurs")
+    assert run["n_outliers"][0] == 6 and run["n_rejected"][0] == 7  # les six aberrations et une position
+    assert np.isnan(run["lost"][0])
+    assert run["rms"][0] > base["rms"][0]  # l'estimation tremble un peu plus
+
+
+# =========================================================================== cibles qui manœuvrent
+
+
+def _manoeuvre():
+    from kalman_course.scenarios import manoeuvre as man
+
+    study = man.manoeuvre_study()
+    return man, study, (study.t > 10.0) & ~study.turning
+
+
+@promise("cibles-manoeuvrantes", 1, 1)
+def _fading_none():
+    _, study, _ = _manoeuvre()
+    run = at("manoeuvre-oubli-curseurs", alpha=1.0)
+    turn = study.turning
+    assert np.mean(run["err"][turn] > run["sd"][turn]) > 0.9  # l'erreur passe le 2σ dans presque tout virage
+    assert run["err"].max() > 5 * run["sd"].max()  # de loin
+    assert y_axis("manoeuvre-oubli-curseurs", 1, alpha=1.0)[1] >= run["err"].max()  # et on la voit
+    measured = rms(np.hypot(*(study.y[:, :2] - study.truth[:, :2]).T))
+    assert rms(run["err"][turn]) > 5 * measured  # le virage est coupé : bien pire que les relevés
+
+
+@promise("cibles-manoeuvrantes", 1, 2)
+def _fading_moderate():
+    _, study, straight = _manoeuvre()
+    runs = {a: at("manoeuvre-oubli-curseurs", alpha=a) for a in (1.0, 1.2, 1.5)}
+    for run in runs.values():  # la lecture est celle des courbes
+        assert run["rms"][0] == pytest.approx(rms(run["err"][straight]))
+        assert run["rms"][1] == pytest.approx(rms(run["err"][study.turning]))
+    assert runs[1.5]["rms"][1] < runs[1.2]["rms"][1] < 0.2 * runs[1.0]["rms"][1]  # virages : de mieux en mieux
+    assert runs[1.2]["rms"][0] < 0.5 * runs[1.0]["rms"][0]  # ligne droite : gain de 1 à 1,2
+    assert runs[1.5]["rms"][0] > 1.2 * runs[1.2]["rms"][0]  # … puis l'erreur y remonte
+
+
+@promise("cibles-manoeuvrantes", 1, 3)
+def _fading_strong():
+    man, study, straight = _manoeuvre()
+    run, mild = at("manoeuvre-oubli-curseurs", alpha=2.0), at("manoeuvre-oubli-curseurs", alpha=1.2)
+    one_reading = 2 * math.sqrt(2) * man.POSITION_STD  # 2σ d'un relevé (deux axes de σ chacun)
+    assert np.median(run["sd"][straight]) == pytest.approx(one_reading, rel=0.05)
+    # l'estimation tremble comme les relevés
+    assert roughness(run["est_e"]) > 0.8 * roughness(run["meas_e"])
+    assert roughness(run["est_e"]) > 2 * roughness(mild["est_e"])
+    assert run["rms"][0] > 1.4 * mild["rms"][0]
+
+
+def _rise_times(run, study, man) -> list[float]:
+    """Secondes entre le début de chaque virage et le premier pas où μ(agité) dépasse 1/2."""
+    out = []
+    for start, _, _ in man.TURNS:
+        k = np.flatnonzero((study.t >= start) & (run["mu"] > 0.5))
+        out.append(float(study.t[k[0]] - start) if k.size else math.inf)
+    return out
+
+
+@promise("cibles-manoeuvrantes", 2, 1)
+def _imm_switch():
+    _, _, straight = _manoeuvre()
+    sticky, loose = at("manoeuvre-imm-curseurs", switch=0.005), at("manoeuvre-imm-curseurs", switch=0.2)
+    assert np.mean(sticky["mu"][straight]) < 0.2 < 0.4 < np.mean(loose["mu"][straight])  # μ(agité) monte
+    assert loose["rms"][0] > 1.3 * sticky["rms"][0]  # et l'erreur hors des virages avec elle
+    assert roughness(loose["est_e"]) > roughness(sticky["est_e"])  # l'estimation tremble plus
+
+
+@promise("cibles-manoeuvrantes", 2, 2)
+def _imm_rise():
+    man, study, _ = _manoeuvre()
+    for switch in ki.slider_grid("manoeuvre-imm-curseurs").axes[0].values:
+        rises = _rise_times(at("manoeuvre-imm-curseurs", switch=switch), study, man)
+        assert max(rises) <= 8.0, f"π = {switch} : {rises}"  # quelques secondes, quelle que soit π
+
+
+@promise("cibles-manoeuvrantes", 2, 3)
+def _imm_quiet_manoeuvre_regime():
+    base = at("manoeuvre-imm-curseurs", switch=0.05, q_quiet=0.05)
+    weak = at("manoeuvre-imm-curseurs", switch=0.05, q_quiet=0.05, q_manoeuvre=2.0)
+    assert weak["rms"][1] > 1.5 * base["rms"][1]  # l'erreur dans les virages double presque
+    assert weak["err"].max() > 1.2 * base["err"].max()  # l'IMM décroche
+
+
+# =========================================================================== filtrer en parallèle
+
+
+def _blelloch_combinations(T: int) -> int:
+    """Combinaisons du balayage de Blelloch, comptées ici : T − 1 à la montée, T − 1 − ⌊log₂ T⌋ à la
+    descente (environ 2T)."""
+    return 2 * (T - 1) - int(math.floor(math.log2(T)))
+
+
+@promise("filtrage-parallele", 1, 1)
+def _parallel_one_processor():
+    from kalman_course.interactive.parallel import LENGTHS
+
+    for c in ki.slider_grid("parallele-processeurs").axes[1].values:
+        run = at("parallele-processeurs", processors=1, cost=c)
+        assert np.all(run["parallel"] > run["sequential"])  # la bleue toujours au-dessus de la rouge
+        assert np.all(run["speedup"] < 1)
+        expected = c * np.array([_blelloch_combinations(int(T)) for T in LENGTHS])
+        np.testing.assert_allclose(run["parallel"], expected, rtol=0.1)  # environ 2T combinaisons de coût c
+        assert run["parallel"][-1] == pytest.approx(2 * c * LENGTHS[-1], rel=0.01)
+        lo, hi = y_axis("parallele-processeurs", 0, processors=1, cost=c)
+        assert lo <= run["sequential"].min() and run["parallel"].max() <= hi  # dans l'axe
+
+
+@promise("filtrage-parallele", 1, 2)
+def _parallel_gpu():
+    from kalman_course.interactive.parallel import LENGTHS
+
+    cost = ki.slider_grid("parallele-processeurs").axes[1]
+    c = float(cost.values[cost.default])
+    for P in (1024, 100_000):
+        run = at("parallele-processeurs", processors=P)
+        few = (LENGTHS >= 100) & (LENGTHS <= P)  # T petit devant P : environ 2c log₂ T
+        ratio = run["parallel"][few] / (2 * c * np.log2(LENGTHS[few]))
+        assert np.all((ratio > 0.75) & (ratio < 1.1))
+        assert np.all(np.diff(run["speedup"]) >= -1e-9 * run["speedup"][1:])  # l'accélération croît
+    gpu = at("parallele-processeurs", processors=1024)
+    assert gpu["speedup"][-1] == pytest.approx(1024 / (2 * c), rel=0.05)  # T ≫ P : plafond P/(2c)
+    assert gpu["speedup"][-1] < 1.2 * gpu["speedup"][np.searchsorted(LENGTHS, 1e5)]  # il plafonne
+    assert at("parallele-processeurs", processors=100_000)["speedup"][-1] > 10 * gpu["speedup"][-1]
+
+
+@promise("filtrage-parallele", 1, 3)
+def _parallel_short_series():
+    from kalman_course.interactive.parallel import LENGTHS
+
+    run = at("parallele-processeurs", processors=1024)
+    short = LENGTHS <= 100
+    assert np.all(run["parallel"][short] <= 30) and run["sequential"][short].max() <= 100  # quelques dizaines
+    assert np.all(run["speedup"][short] < 5)  # le gain est faible
+    assert run["speedup"][np.searchsorted(LENGTHS, 1e4)] > 20 * run["speedup"][short].max()  # à côté des longues
+
+
+# =========================================================================== un seul filtre gaussien
+
+
+def _to_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
+    """Distance de chaque point (N, 2) à la ligne brisée ``line`` (M, 2)."""
+    a, b = line[:-1], line[1:]
+    ab = b - a
+    t = np.clip(np.einsum("pmk,mk->pm", points[:, None, :] - a[None], ab) / np.einsum("mk,mk->m", ab, ab), 0, 1)
+    nearest = a[None] + t[..., None] * ab[None]
+    return np.min(np.linalg.norm(points[:, None, :] - nearest, axis=-1), axis=1)
+
+
+def _contour_gap(run, key: str) -> float:
+    """Écart (m, distance de Hausdorff) entre le contour de la règle ``key`` et celui de la vérité."""
+    rule = np.column_stack([run[f"{key}_x"], run[f"{key}_y"]])
+    truth = np.column_stack([run["truth_x"], run["truth_y"]])
+    return float(max(_to_polyline(rule, truth).max(), _to_polyline(truth, rule).max()))
+
+
+@promise("filtre-gaussien", 1, 1)
+def _gaussian_large_uncertainty():
+    run = at("gaussien-banane-regles", bearing_std=60.0)
+    s = math.radians(60.0)
+    assert run["truth_my"][0] == pytest.approx(math.exp(-s ** 2 / 2), rel=1e-3)  # E[sin θ] = e^{−σ²/2}
+    assert math.hypot(run["lin_mx"][0], run["lin_my"][0]) == pytest.approx(1.0)  # sur l'arc (r = 1 m)
+    assert run["lin_err"][0] > 0.3  # à plusieurs décimètres de la vraie
+    assert np.ptp(run["lin_y"]) < 0.1 * np.ptp(run["truth_y"])  # une ellipse plate
+    assert 0.01 < run["ckf_err"][0] < 0.05  # quelques centimètres
+    assert run["gh_err"][0] < 0.01  # moins d'un centimètre (p = 3 par défaut)
+    assert np.ptp(run["gh_y"]) > 1.1 * np.ptp(run["truth_y"])  # mais son ellipse déborde
+    (x0, x1), (y0, y1) = _static("gaussien-banane-regles").ranges_at(0, *position("gaussien-banane-regles",
+                                                                                    bearing_std=60.0))
+    assert x0 <= run["lin_x"].min() and run["lin_x"].max() <= x1 and y0 <= run["gh_y"].min()  # tout est visible
+
+
+@promise("filtre-gaussien", 1, 2)
+def _gaussian_order():
+    runs = {p: at("gaussien-banane-regles", bearing_std=60.0, order=p) for p in (2, 3, 4, 5, 8)}
+    assert runs[2]["gh_err"][0] > 2 * runs[2]["ckf_err"][0]  # p = 2 se trompe davantage que la cubature
+    errors = [runs[p]["gh_err"][0] for p in (2, 3, 4, 5, 8)]
+    assert all(b < a for a, b in zip(errors, errors[1:]))  # chaque ordre de plus gagne
+    assert _contour_gap(runs[8], "gh") < 0.01 * np.ptp(runs[8]["truth_x"])  # p = 8 : la violette couvre la noire
+    assert "8² = 64 points" in readout("gaussien-banane-regles", bearing_std=60.0, order=8)
+
+
+@promise("filtre-gaussien", 1, 3)
+def _gaussian_small_uncertainty():
+    run = at("gaussien-banane-regles", bearing_std=5.0)
+    size = np.ptp(run["truth_x"])
+    for key in ("lin", "ckf", "gh"):  # toutes les ellipses se confondent
+        assert _contour_gap(run, key) < 0.05 * size, key
+    assert run["lin_err"][0] < 0.05 * size  # même la moyenne linéarisée est à sa place, à cette échelle
+
+
+# =========================================================================== quel filtre choisir ?
+
+_GAUSSIAN_FILTERS = ("ekf", "iekf", "ukf", "ckf", "ghkf")
+
+
+def _in_band(run, key: str) -> np.ndarray:
+    return (run[f"{key}_nees"] >= run["band_lo"]) & (run[f"{key}_nees"] <= run["band_hi"])
+
+
+@promise("quel-filtre", 1, 1)
+def _choice_small_uncertainty():
+    from kalman_course.scenarios.filter_choice import CHOICE_RUNS
+
+    run = at("choix-incertitude", prior_std=10.0)
+    lo, hi = scipy.stats.chi2.ppf([0.025, 0.975], 4 * CHOICE_RUNS) / CHOICE_RUNS  # bande de la NEES moyenne
+    assert (run["band_lo"][0], run["band_hi"][0]) == pytest.approx((lo, hi))
+    for key in _GAUSSIAN_FILTERS + ("enkf",):
+        assert np.mean(_in_band(run, key)) >= 0.95, key  # dans la bande verte
+    ref = run["ekf_nees"]
+    for key in _GAUSSIAN_FILTERS:
+        np.testing.assert_allclose(run[f"{key}_nees"], ref, rtol=0.05)  # superposées
+    assert np.all(run["pf_nees"] > 100 * hi)  # le filtre particulaire à part
+
+
+@promise("quel-filtre", 1, 2)
+def _choice_where_each_breaks():
+    hundred, three, thousand = (at("choix-incertitude", prior_std=s) for s in (100.0, 300.0, 1000.0))
+    assert hundred["ekf_nees"][0] > 100 and np.mean(_in_band(hundred, "ekf")) < 0.5  # l'EKF sort nettement
+    for key in ("ukf", "ckf"):  # l'UKF et la cubature un peu, au début
+        assert hundred["band_hi"][0] < hundred[f"{key}_nees"][0] < 10
+        assert np.mean(_in_band(hundred, key)) < 0.75
+    for key in ("ghkf", "enkf"):
+        assert np.mean(_in_band(hundred, key)) >= 0.95, key
+    for key in ("ukf", "ckf", "ghkf", "enkf"):  # à 300 m, tous sortent au début de la série
+        assert three[f"{key}_nees"][:10].max() > 100, key
+    for s in (10.0, 100.0, 300.0, 1000.0):  # l'EKF itéré reste dans la bande
+        assert np.mean(_in_band(at("choix-incertitude", prior_std=s), "iekf")) >= 0.95, s
+    assert np.mean(_in_band(thousand, "ukf")) >= 0.9  # à 1 km, l'UKF y revient
+    assert thousand["ckf_nees"].max() > 1e3 and thousand["ekf_nees"].min() > 1e3
+
+
+@promise("quel-filtre", 1, 3)
+def _choice_particle_filter():
+    for s in ki.slider_grid("choix-incertitude").axes[0].values:
+        run = at("choix-incertitude", prior_std=s)
+        assert np.all(run["pf_nees"] > run["band_hi"]), s  # partout hors de la bande
+        assert run["pf_rmse"][0] > 10 * run["iekf_rmse"][0], s  # et loin de la cible
+
+
 # --------------------------------------------------------------------------- (en dernier : après les inscriptions)
 
 

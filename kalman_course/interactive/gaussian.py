@@ -14,7 +14,7 @@ import numpy as np
 from ..scenarios import banana, gaussian_rules
 from .figure import SliderSpec, ellipse_outline, number, register_sliders
 from .grid import ParameterAxis
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["N_POINTS", "ORDERS", "BEARING_STDS_DEG", "rules_axes", "rules_run", "rules_spec"]
 
@@ -84,7 +84,8 @@ def rules_spec() -> SliderSpec:
             Panel("Ellipses à 2σ et moyennes", "y (m)",
                   cloud + _glyphs("truth", "black", "vérité") + _glyphs("lin", "firebrick", "linéarisation")
                   + _glyphs("ckf", "seagreen", "cubature") + _glyphs("gh", "purple", "Gauss–Hermite"),
-                  x_label="x (m)", x_range=(-1.15, 1.15), y_range=(-0.15, 1.35), equal_aspect=True, height=380),
+                  x_label="x (m)", x_range=(-1.15, 1.15), y_range=Follow(aspect=2.3 / 1.5, margin=0.06), equal_aspect=True,
+                  height=380),  # à 60°, les ellipses débordent du cadre de 20°
         ),
         readout=_readout,
     )

@@ -48,7 +48,7 @@ def parallel_axes() -> tuple[ParameterAxis, ParameterAxis]:
     r""":math:`P` (processeurs, défaut 1) et :math:`c` (coût d'une combinaison, défaut 2)."""
     return (
         ParameterAxis("processors", "P", "processeurs", "", np.array(PROCESSORS, dtype=float), default=0,
-                      scale="index", tick_labels=tuple(number(p) for p in PROCESSORS)),
+                      scale="index", tick_labels=tuple(number(p, significant=6) for p in PROCESSORS)),
         ParameterAxis("cost", "c", "coût d'une combinaison (pas séquentiels)", "", np.array(COSTS), default=1,
                       scale="index", tick_labels=tuple(number(c) for c in COSTS)),
     )
@@ -65,7 +65,7 @@ def parallel_run(processors: float, cost: float) -> dict[str, np.ndarray]:
 def _readout(series, values) -> str:
     P, c = int(round(values[0])), values[1]
     s = series["speedup"]
-    return (f"P = {number(P)} processeur(s), une combinaison coûte {number(c)} pas : accélération (temps séquentiel / "
+    return (f"P = {number(P, significant=6)} processeur(s), une combinaison coûte {number(c)} pas : accélération (temps séquentiel / "
             f"temps du balayage) {number(s[np.searchsorted(LENGTHS, 1000)])} à T = 1 000 et {number(s[-1])} à "
             "T = 10⁶ (au-dessous de 1, le balayage est plus lent).")
 
@@ -86,12 +86,12 @@ def parallel_spec() -> SliderSpec:
                   (Glyph("sequential", "line", "firebrick", "filtre séquentiel : T"),
                    Glyph("parallel", "line", "royalblue", "balayage : c Σ ⌈w/P⌉")),
                   y_log=True, x_log=True, x_label="longueur de la série T (pas)", x_range=(10.0, 1e6),
-                  y_range=(1.0, 1e7), height=260),
+                  y_range=(1.0, 1e8), height=260),
             Panel("Accélération (séquentiel / balayage)", "rapport (sans unité)",
                   (Glyph("speedup", "line", "royalblue", "accélération"),
                    Glyph("speedup", "hline", "black", "1 : aucun gain", value=1.0, dash="dashed")),
                   y_log=True, x_log=True, x_label="longueur de la série T (pas)", x_range=(10.0, 1e6),
-                  y_range=(0.1, 1e5), height=220),
+                  y_range=(0.01, 1e5), height=220),
         ),
         readout=_readout,
     )

@@ -22,7 +22,7 @@ from ..scenarios import helicopter as heli
 from ..scenarios import manoeuvre as man
 from .figure import SliderSpec, ellipse_outline, number, register_sliders
 from .grid import ParameterAxis
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["GATES", "Q_FACTORS", "gate_axes", "gate_run", "gate_spec", "FADINGS", "fading_axes", "fading_run",
            "fading_spec", "SWITCHES", "QUIET_DENSITIES", "MANOEUVRE_DENSITIES", "imm_axes", "imm_run", "imm_spec"]
@@ -115,12 +115,12 @@ def gate_spec() -> SliderSpec:
                 Glyph("ell_n", "line", "royalblue", "ellipses à 2σ", x="ell_e", width=1.0, alpha=0.7),
                 Glyph("est_n", "line", "darkorange", "estimation", x="est_e", width=1.8),
                 Glyph("rej_n", "scatter", "black", "positions rejetées", x="rej_e", marker="circle", size=7),
-            ), x_label="est (km)", x_range=(-1.5, 5.5), y_range=(-7.0, 0.8), equal_aspect=True, width=460,
-                height=420),
+            ), x_label="est (km)", x_range=(-1.5, 5.5), y_range=Follow(aspect=7.0 / 7.8, margin=0.04),
+                equal_aspect=True, width=460, height=420),  # une piste perdue part loin : le plan la suit
             Panel("NIS de chaque position et seuil de la porte", "NIS (sans unité)", (
                 Glyph("nis", "scatter", "darkorange", "NIS", marker="dot", size=6),
                 Glyph("threshold", "line", "black", "seuil χ²₂(p)", dash="dashed", width=1.5),
-            ), y_log=True, y_range=(1e-3, 1e6), height=220),
+            ), y_log=True, y_range=(1e-4, 1e6), height=220),
         ),
         fixed={"meas_e": e, "meas_n": n, "out_e": y[bad, 0] / 1e3, "out_n": y[bad, 1] / 1e3},
         readout=_gate_readout,
@@ -198,7 +198,7 @@ def fading_spec() -> SliderSpec:
                 Glyph("turn", "area", "gray", "virages", alpha=0.6),
                 Glyph("sd", "line", "royalblue", "2σ annoncé", dash="dashed", width=1.5),
                 Glyph("err", "line", "darkorange", "erreur de position", width=1.6),
-            ), y_log=False, y_range=(0.0, 120.0), height=230),
+            ), y_log=False, y_range=Follow(include=(0.0,)), height=230),  # sans oubli, l'erreur passe 120 m
         ),
         fixed=_example_fixed(),
         readout=_fading_readout,
