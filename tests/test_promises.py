@@ -1008,13 +1008,17 @@ def _gate_tight():
 
 @promise("capteurs-temps-irregulier", 1, 3)
 def _gate_small_q():
-    _, track, _, _ = _helicopter()
+    _, track, rows, _ = _helicopter()
     run = at("capteurs-porte-curseurs", gate=0.999, q="min")
     q = ki.slider_grid("capteurs-porte-curseurs").axes[1]
     assert q.values[0] == pytest.approx(q.values[q.default] / 100)  # q divisé par 100
     lost = run["lost"][0]
-    assert lost < 15.0  # la piste part dès les premières secondes
+    assert lost < 15.0  # la piste se perd tôt…
     t, nis = np.asarray(track.t), run["nis"]
+    seen = rows & (t <= lost + 2.0)  # … avant le premier virage : le cap mesuré n'a pas encore tourné
+    step = np.diff(np.asarray(track.y)[seen][:, :2], axis=0)
+    heading = np.degrees(np.unwrap(np.arctan2(step[:, 1], step[:, 0])))
+    assert np.ptp(heading) < 10.0
     ok = np.isfinite(nis)
     assert np.median(nis[ok & (t < lost)]) < 3.0  # avant : la NIS d'un filtre qui suit (2 attendu)
     assert np.max(nis[ok]) > 1e3  # des milliers
