@@ -1095,7 +1095,8 @@ def _rise_times(run, study, man) -> list[float]:
 def _imm_switch():
     _, _, straight = _manoeuvre()
     sticky, loose = at("manoeuvre-imm-curseurs", switch=0.005), at("manoeuvre-imm-curseurs", switch=0.2)
-    assert np.mean(sticky["mu"][straight]) < 0.2 < 0.4 < np.mean(loose["mu"][straight])  # μ(agité) monte
+    assert np.mean(sticky["mu"][straight]) < 0.2  # collante : μ(agité) reste basse en ligne droite
+    assert np.mean(loose["mu"][straight]) > 3 * np.mean(sticky["mu"][straight])  # avec 0,2, elle monte
     assert loose["rms"][0] > 1.3 * sticky["rms"][0]  # et l'erreur hors des virages avec elle
     assert roughness(loose["est_e"]) > roughness(sticky["est_e"])  # l'estimation tremble plus
 
