@@ -15,7 +15,7 @@ import pytest
 
 import kalman_course.interactive as ki
 from kalman_course.sphinx import pages
-from kalman_course.interactive.quiz import tex_to_text
+from kalman_course.sphinx.quiz import tex_to_text
 
 ROOT = Path(__file__).resolve().parent.parent
 BOOK = ROOT / "book"
