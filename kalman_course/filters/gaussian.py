@@ -364,7 +364,7 @@ class SigmaPointRule(GaussianRule):
 @dataclass(frozen=True)
 class SymmetricSigmaRule(SigmaPointRule):
     r"""Règle symétrique à :math:`2n` (ou :math:`2n + 1`) points : :math:`\hat x \pm s_i`, où :math:`s_i`
-    est la :math:`i`-ème **ligne** du facteur de Cholesky supérieur :math:`U` de :math:`cP`
+    est la **ligne** :math:`i` du facteur de Cholesky supérieur :math:`U` de :math:`cP`
     (:math:`U^TU = cP`, la convention de filterpy), précédés de :math:`\chi_0 = \hat x` si la règle a un
     point central. Une sous-classe donne :meth:`scale` (:math:`c`), :meth:`weights` et ``central``.
 

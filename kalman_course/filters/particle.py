@@ -113,8 +113,8 @@ def _residual(w: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 
 def multinomial_resample(weights: Any, u: Any) -> np.ndarray:
-    r"""Rééchantillonnage multinomial : :math:`N` tirages indépendants selon les poids, la :math:`k`-ième
-    copie est la particule :math:`F^{-1}(u_k)` (:math:`F` : fonction de répartition des poids).
+    r"""Rééchantillonnage multinomial : :math:`N` tirages indépendants selon les poids, la copie
+    :math:`k` est la particule :math:`F^{-1}(u_k)` (:math:`F` : fonction de répartition des poids).
 
     ``weights`` (N,) normalisés ; ``u`` (N,) uniformes dans [0, 1). Renvoie les indices (N,) (entiers)."""
     w = _check_weights(weights)

@@ -82,7 +82,7 @@ class SquareRootInformation(NamedTuple):
 class SrifUpdate(NamedTuple):
     r"""Résultat de :func:`srif_update` : ``R`` (n, n), ``z`` (n,) a posteriori, et ``residual`` (m,) =
     :math:`z_r`, dont la norme au carré :math:`\lVert z_r\rVert^2` est la somme des carrés des résidus
-    blanchis (égale au NIS :math:`\nu^TS^{-1}\nu` quand l'a priori est de rang plein). Seule la norme de
+    blanchis (égale à la NIS :math:`\nu^TS^{-1}\nu` quand l'a priori est de rang plein). Seule la norme de
     :math:`z_r` a un sens (la QR la concentre sur la première composante)."""
 
     R: np.ndarray
@@ -556,7 +556,7 @@ def _require_state(R: np.ndarray, z: np.ndarray, what: str) -> np.ndarray:
     if information_rank(R) < R.shape[0]:
         raise KalmanInputError(
             f"Le SRIF étendu linéarise autour de {what} : il faut une information de rang plein "
-            "(« R_xx » inversible), donc un a priori (x0, P0) ; un départ diffus n'est possible qu'en linéaire."
+            "(« R_xx » inversible), donc un a priori (x0, P0) ; une initialisation diffuse n'est possible qu'en linéaire."
         )
     return _state(R, z)[0]
 

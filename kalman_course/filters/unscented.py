@@ -9,7 +9,7 @@ moyenne :math:`\bar x` et de covariance :math:`P` :
     \lambda = \alpha^2(n + \kappa) - n,\qquad
     \chi_0 = \bar x,\quad \chi_i = \bar x + s_i,\quad \chi_{n+i} = \bar x - s_i\quad (i = 1\dots n),
 
-où :math:`s_i` est la :math:`i`-ème **ligne** du facteur de Cholesky supérieur :math:`U` de
+où :math:`s_i` est la **ligne** :math:`i` du facteur de Cholesky supérieur :math:`U` de
 :math:`(n+\lambda)P` (:math:`U^TU = (n+\lambda)P`, comme ``MerweScaledSigmaPoints`` de filterpy), et les poids
 
 .. math::
