@@ -400,7 +400,7 @@ NIS = Exercise(
     shapes_hint="innovations (T, m), S (T, m, m) ; eps (T,), une valeur par pas",
     mistakes=(
         Mistake("s-not-inverted", "νᵀ S ν au lieu de νᵀ S⁻¹ ν",
-                "Le NIS normalise l'innovation par sa covariance : ε = νᵀ S⁻¹ ν (`nu @ np.linalg.solve(S_k, nu)`). "
+                "La NIS normalise l'innovation par sa covariance : ε = νᵀ S⁻¹ ν (`nu @ np.linalg.solve(S_k, nu)`). "
                 "Avec S au lieu de S⁻¹, ε n'a plus la loi du χ² à m degrés de liberté.", _nis_s_not_inverted),
         Mistake("no-s", "S oubliée (νᵀ ν)",
                 "ε = νᵀ S⁻¹ ν : sans S, la taille de l'innovation n'est pas comparée à ce que le filtre attend, "
