@@ -232,7 +232,7 @@ def log_likelihood(model: LinearGaussianModel, y: Any, x0: Any = None, P0: Any =
     model : LinearGaussianModel
     y : (T, m), ou (T,) si m = 1 — ``NaN``/``None`` : composante manquante.
     x0 : (n,), P0 : (n, n), optionnels, ensemble.
-    u : (T, p), ou (T,) si p = 1, optionnel.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
 
     Renvoie un ``float`` (nats).
     """
@@ -460,7 +460,7 @@ def maximum_likelihood(
     theta0 : (q,) — point de départ ; la vraisemblance doit y être finie et chaque composante doit agir
         sur le modèle.
     x0, P0 : a priori connu (sinon initialisation diffuse exacte), comme :func:`log_likelihood`.
-    u : (T, p), optionnel — commandes.
+    u : (T, p), optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     method : méthode de ``scipy.optimize.minimize`` (``"BFGS"`` par défaut, ``"Nelder-Mead"``…).
 
     Un point d'essai où ``build`` refuse les paramètres (:class:`KalmanInputError`) ou où la
@@ -699,7 +699,7 @@ def expectation_maximization(
     model : LinearGaussianModel — point de départ (ses :math:`Q`, :math:`R` initiales).
     y : (T, m), ou (T,) si m = 1 ; ``NaN`` : manquante.
     x0, P0 : a priori connu (sinon initialisation diffuse exacte), comme :func:`log_likelihood`.
-    u : (T, p), optionnel.
+    u : (T, p), optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     max_iter : nombre maximal d'itérations (≥ 1) ; tol : seuil relatif d'arrêt (> 0).
 
     Renvoie un :class:`EMResult`.

@@ -87,7 +87,7 @@ def cubature_kalman_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: A
         ``f`` et ``h`` en un appel).
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante.
     x0 : (n,) ; P0 : (n, n) symétrique **définie** positive.
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     redraw : ``True`` (défaut) : nouveaux points à la correction — égal à
         ``unscented_kalman_filter(alpha=1, beta=0, kappa=0)`` et, sur un modèle linéaire, au filtre de
         Kalman ; ``False`` : points propagés réutilisés — égal à ``CubatureKalmanFilter`` de filterpy.

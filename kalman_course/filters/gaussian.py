@@ -572,7 +572,7 @@ def gaussian_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = No
     model : NonlinearModel (bruits additifs pour une règle à points).
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante.
     x0 : (n,) ; P0 : (n, n) (définie positive pour une règle à points).
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     rule : la règle d'intégration.
     redraw : ``True`` : la correction tire de nouveaux points de :math:`(\hat x^-, P^-)` ; ``False`` :
         elle réutilise les points propagés par :math:`f` (sans effet pour la linéarisation).

@@ -215,7 +215,8 @@ def kalman_filter(
         (gain nul). Une ligne partiellement manquante n'utilise que ses composantes présentes.
     x0 : (n,) — :math:`\hat x_0` (scalaire accepté si n = 1).
     P0 : (n, n) — :math:`P_0`, symétrique semi-définie positive (scalaire accepté si n = 1).
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes (exige un modèle avec ``B``).
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (exige un modèle avec ``B`` ;
+        ``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     form : ``"square_root"`` (par défaut : racine carrée de :math:`P`, sûre pour un :math:`P_0` vague),
         ``"textbook"`` (:math:`P = (I - KC)P^-`, la formule du cours) ou ``"joseph"`` — voir l'en-tête
         du module.

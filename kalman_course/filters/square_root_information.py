@@ -488,7 +488,7 @@ def square_root_information_filter(
     model : LinearGaussianModel
     y : (T, m), ou (T,) si m = 1 — ``NaN``/``None`` : composante manquante.
     x0 : (n,), P0 : (n, n) définie positive — optionnels, ensemble.
-    u : (T, p), ou (T,) si p = 1, optionnel.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     R0 : (n, n) triangulaire supérieure, z0 : (n,) — optionnels, ensemble.
     method : ``"inverse"`` (défaut, :math:`A` inversible) ou ``"joint"`` (sans :math:`A^{-1}`, :math:`Q`
         définie positive), voir :func:`srif_predict`.

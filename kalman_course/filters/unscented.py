@@ -277,7 +277,7 @@ def unscented_kalman_filter(
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante (ligne entière : prédiction seule ;
         ligne partielle : correction avec les seules composantes observées).
     x0 : (n,) ; P0 : (n, n) symétrique **définie** positive (les points sigma en prennent une racine).
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     alpha, beta, kappa : paramètres des points sigma de van der Merwe (sans valeur par défaut pour
         ``alpha`` et ``kappa`` : le bon choix dépend du problème ; :math:`\beta = 2` est optimal pour une
         loi gaussienne). :math:`\alpha = 1, \beta = 2, \kappa = 0` redonne exactement le filtre de Kalman
