@@ -1,4 +1,4 @@
-r"""Vraisemblance d'un modèle linéaire gaussien, départ diffus exact, maximum de vraisemblance et EM.
+r"""Vraisemblance d'un modèle linéaire gaussien, initialisation diffuse exacte, maximum de vraisemblance et EM.
 
 **Décomposition en erreurs de prédiction.** Les innovations :math:`\nu_k = y_k - C\hat x_{k\mid k-1}`
 sont indépendantes, de lois :math:`\mathcal N(0, S_k)` : la densité des mesures est le produit de
@@ -12,7 +12,7 @@ leurs densités,
 :math:`p_k` étant le nombre de composantes observées de :math:`y_k` (un pas sans mesure n'ajoute rien ;
 une mesure partielle compte ses seules composantes observées, avec le bloc correspondant de :math:`S_k`).
 
-**Départ diffus exact** (Durbin & Koopman 2012, § 5.2 et § 7.2.2 ; de Jong 1991). Sans a priori sur
+**Initialisation diffuse exacte** (Durbin & Koopman 2012, § 5.2 et § 7.2.2 ; de Jong 1991). Sans a priori sur
 l'état :math:`\delta` de la première mesure, la vraisemblance est la limite de
 :math:`\kappa^{n/2}L_\kappa` quand l'a priori :math:`\mathcal N(0, \kappa I)` s'élargit. Avec le filtre
 augmenté (:mod:`kalman_course.filters.diffuse` : innovations :math:`v_k - E_k\delta`, covariances
@@ -101,7 +101,7 @@ def log_likelihood_terms(result: FilterResult) -> np.ndarray:
     :math:`\nu_k^TS_k^{-1}\nu_k = \lVert L_k^{-1}\nu_k\rVert^2`), sur les composantes observées.
 
     Paramètres : ``result`` — :class:`~kalman_course.FilterResult`. Renvoie (T,) : 0 pour un pas sans
-    mesure ; NaN pour un pas observé dont la prédiction n'est pas déterminée (début d'un départ diffus,
+    mesure ; NaN pour un pas observé dont la prédiction n'est pas déterminée (début d'une initialisation diffuse,
     SRIF parti de :math:`\mathcal R_{xx} = 0`).
 
     Filtres de Monte-Carlo : le filtre particulaire a sa propre estimation
@@ -203,10 +203,10 @@ def _diffuse_value(augmented: FilterResult, J: np.ndarray, h: np.ndarray) -> flo
 
 
 def _prior(x0: Any, P0: Any) -> bool:
-    """Vrai si l'a priori est donné, faux pour le départ diffus ; erreur si un seul des deux l'est."""
+    """Vrai si l'a priori est donné, faux pour l'initialisation diffuse ; erreur si un seul des deux l'est."""
     if (x0 is None) != (P0 is None):
         raise KalmanInputError(
-            "« x0 » et « P0 » vont ensemble : donnez les deux (a priori connu) ou aucun (départ diffus exact)."
+            "« x0 » et « P0 » vont ensemble : donnez les deux (a priori connu) ou aucun (initialisation diffuse exacte)."
         )
     return x0 is not None
 
@@ -232,7 +232,7 @@ def log_likelihood(model: LinearGaussianModel, y: Any, x0: Any = None, P0: Any =
     model : LinearGaussianModel
     y : (T, m), ou (T,) si m = 1 — ``NaN``/``None`` : composante manquante.
     x0 : (n,), P0 : (n, n), optionnels, ensemble.
-    u : (T, p), ou (T,) si p = 1, optionnel.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
 
     Renvoie un ``float`` (nats).
     """
@@ -245,7 +245,7 @@ def log_likelihood(model: LinearGaussianModel, y: Any, x0: Any = None, P0: Any =
     check_instance("model", model, LinearGaussianModel, "la vraisemblance est celle d'un modèle linéaire gaussien")
     if _prior(x0, P0):
         return filter_log_likelihood(kalman_filter(model, y, x0, P0, u))
-    # départ diffus : le filtre augmenté et l'information suffisent (pas besoin des estimations exactes)
+    # initialisation diffuse : le filtre augmenté et l'information suffisent (pas besoin des estimations exactes)
     augmented = run_filter(diffuse_family(), model, y, None, None, u)
     J, h = diffuse_information(model, augmented)
     return _diffuse_value(augmented, J[-1], h[-1])
@@ -459,8 +459,8 @@ def maximum_likelihood(
     y : (T, m), ou (T,) si m = 1 — mesures (``NaN`` : manquante).
     theta0 : (q,) — point de départ ; la vraisemblance doit y être finie et chaque composante doit agir
         sur le modèle.
-    x0, P0 : a priori connu (sinon départ diffus exact), comme :func:`log_likelihood`.
-    u : (T, p), optionnel — commandes.
+    x0, P0 : a priori connu (sinon initialisation diffuse exacte), comme :func:`log_likelihood`.
+    u : (T, p), optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     method : méthode de ``scipy.optimize.minimize`` (``"BFGS"`` par défaut, ``"Nelder-Mead"``…).
 
     Un point d'essai où ``build`` refuse les paramètres (:class:`KalmanInputError`) ou où la
@@ -612,13 +612,13 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
 
     la somme sur :math:`Q` portant sur les :math:`N_Q` transitions (depuis l'état initial si l'a priori est
     connu, terme calculé par le lissage des bruits, :func:`_initial_noise_moment`, sûr pour un a priori
-    vague ; à partir de la deuxième mesure au départ diffus). Pour une mesure
+    vague ; à partir de la deuxième mesure à l'initialisation diffuse). Pour une mesure
     manquante, le terme de :math:`R'` est son espérance sachant les composantes observées :
     :math:`R` lui-même si tout manque, sinon
     :math:`M(e_oe_o^T + C_oPC_o^T)M^T + \operatorname{diag}(0, R_{mm} - R_{mo}R_{oo}^{-1}R_{om})`,
     :math:`M = [I;\ R_{mo}R_{oo}^{-1}]` (Shumway & Stoffer).
 
-    Au départ diffus, l'étape E ne passe que par le filtre augmenté (:func:`diffuse_family` dans le
+    À l'initialisation diffuse, l'étape E ne passe que par le filtre augmenté (:func:`diffuse_family` dans le
     moteur), l'information :math:`J_T`, :math:`h_T` et le lissage exact
     (:func:`~kalman_course.filters.smoothers.diffuse_rts_pass`) : ni estimations exactes du filtre, ni
     gains du lisseur exact, ni vérification « ce résultat vient de ce modèle » (l'étape filtre elle-même) ;
@@ -698,8 +698,8 @@ def expectation_maximization(
     ----------
     model : LinearGaussianModel — point de départ (ses :math:`Q`, :math:`R` initiales).
     y : (T, m), ou (T,) si m = 1 ; ``NaN`` : manquante.
-    x0, P0 : a priori connu (sinon départ diffus exact), comme :func:`log_likelihood`.
-    u : (T, p), optionnel.
+    x0, P0 : a priori connu (sinon initialisation diffuse exacte), comme :func:`log_likelihood`.
+    u : (T, p), optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     max_iter : nombre maximal d'itérations (≥ 1) ; tol : seuil relatif d'arrêt (> 0).
 
     Renvoie un :class:`EMResult`.

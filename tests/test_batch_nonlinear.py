@@ -220,7 +220,7 @@ def test_bad_controls_linear_models_and_families_without_batch_mode_are_refused(
         iterated_extended_kalman_filter_runs(model, np.zeros((3, 4, 1)), np.zeros(2), np.eye(2), np.zeros((3, 1)))
     with pytest.raises(kc.KalmanInputError, match=r"« model » doit être un NonlinearModel ; reçu LinearGaussianModel"):
         unscented_kalman_filter_runs(lin, np.zeros((3, 4, 1)), np.zeros(2), np.eye(2), **UKF)
-    with pytest.raises(kc.KalmanInputError, match="Le filtre de Kalman à départ diffus n'a pas de mode en lot"):
+    with pytest.raises(kc.KalmanInputError, match="Le filtre de Kalman à initialisation diffuse n'a pas de mode en lot"):
         run_filter_runs(diffuse_family(), lin, np.zeros((3, 4, 1)), None, None)
 
 

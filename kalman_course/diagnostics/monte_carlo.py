@@ -96,7 +96,7 @@ class MonteCarlo:
         return self.errors.mean(axis=0)
 
     def mean_error_sem(self) -> np.ndarray:
-        r"""Écart-type de la moyenne empirique (erreur standard :math:`s/\sqrt R`), forme (T+1, n)."""
+        r"""Écart-type de la moyenne empirique (erreur type :math:`s/\sqrt R`), forme (T+1, n)."""
         return self.errors.std(axis=0, ddof=1) / np.sqrt(self.n_runs)
 
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..scenarios.labs import nile_lab, pendulum_lab, tag_lab, voltage_lab
 from ._registry import new_figure, register
-from .likelihood import _year_formatter
+from .likelihood import FLOW, _year_formatter
 
 YOURS = "tab:orange"
 PACKAGE = "tab:blue"
@@ -116,7 +116,7 @@ def nile_lab_figure(rts_step=None, m_step=None):
         ax.plot(year, run.student["smoothed"], "--", color=YOURS, lw=1.5, label="votre lisseur")
     ax.set_xlabel("temps (année)")
     ax.xaxis.set_major_formatter(_year_formatter())
-    ax.set_ylabel("débit annuel (10⁸ m³)")
+    ax.set_ylabel(FLOW)
     ax.legend(loc="upper right", fontsize=8)
     it = np.arange(run.reference["variances"].shape[0])
     for j, (name, style) in enumerate(((r"$\sigma^2_\varepsilon$", "-"), (r"$\sigma^2_\eta$", ":"))):

@@ -8,7 +8,7 @@ La règle de cubature sphérique–radiale du troisième degré remplace l'inté
     \chi_i = \hat x + \sqrt n\, s_i,\qquad \chi_{n+i} = \hat x - \sqrt n\, s_i\quad (i = 1\dots n),
     \qquad W_i = \frac{1}{2n},
 
-où :math:`s_i` est la :math:`i`-ème ligne du facteur de Cholesky supérieur de :math:`P` (comme
+où :math:`s_i` est la ligne :math:`i` du facteur de Cholesky supérieur de :math:`P` (comme
 ``spherical_radial_sigmas`` de filterpy). Tous les poids sont positifs et égaux (c'est la transformée sans
 parfum avec :math:`\alpha = 1, \beta = 0, \kappa = 0`, dont le point central a alors un poids nul) ; la
 règle est exacte pour les polynômes de degré 3.
@@ -87,7 +87,7 @@ def cubature_kalman_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: A
         ``f`` et ``h`` en un appel).
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante.
     x0 : (n,) ; P0 : (n, n) symétrique **définie** positive.
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     redraw : ``True`` (défaut) : nouveaux points à la correction — égal à
         ``unscented_kalman_filter(alpha=1, beta=0, kappa=0)`` et, sur un modèle linéaire, au filtre de
         Kalman ; ``False`` : points propagés réutilisés — égal à ``CubatureKalmanFilter`` de filterpy.

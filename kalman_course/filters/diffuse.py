@@ -1,4 +1,4 @@
-r"""Filtre de Kalman à départ diffus exact : aucun a priori sur l'état (filtre augmenté de de Jong).
+r"""Filtre de Kalman à initialisation diffuse exacte : aucun a priori sur l'état (filtre augmenté de de Jong).
 
 Convention (Durbin & Koopman 2012, § 5.2 ; statsmodels ``use_exact_diffuse=True``) : l'état
 :math:`x_1` de la première mesure ``y[0]`` n'a **aucun a priori**. On l'écrit :math:`x_1 = \delta`,
@@ -28,7 +28,7 @@ de :math:`y_1, \dots, y_k` est gaussienne, d'information et de vecteur d'informa
 
 et, dès que :math:`J_k` est inversible (l'état est alors **déterminé** par les mesures),
 :math:`\delta \mid y_{1:k} \sim \mathcal N(J_k^{-1}h_k,\ J_k^{-1})`. Par la loi des espérances et des
-variances totales, l'estimation exacte du départ diffus est
+variances totales, l'estimation exacte de l'initialisation diffuse est
 
 .. math::
 
@@ -102,9 +102,9 @@ def diffuse_family() -> FilterFamily:
         return (xa, P), Correction(K, V[:, 0], S)
 
     return FilterFamily(
-        name="filtre de Kalman à départ diffus",
+        name="filtre de Kalman à initialisation diffuse",
         model_type=LinearGaussianModel,
-        model_hint="le départ diffus exact n'existe ici que pour un modèle linéaire",
+        model_hint="l'initialisation diffuse exacte n'existe ici que pour un modèle linéaire",
         prior=prior,
         predict=predict_step,
         update=update_step,
@@ -119,7 +119,7 @@ def diffuse_family() -> FilterFamily:
 @dataclass(frozen=True, eq=False, repr=False)
 class DiffuseFilterResult(FilterResult):
     r"""Résultat de :func:`diffuse_kalman_filter` : un :class:`~kalman_course.FilterResult` (estimations
-    exactes du départ diffus, lignes NaN tant que l'état n'est pas déterminé) et les pièces du filtre
+    exactes de l'initialisation diffuse, lignes NaN tant que l'état n'est pas déterminé) et les pièces du filtre
     augmenté dont se servent le lisseur et la vraisemblance.
 
     Attributs supplémentaires
@@ -215,7 +215,7 @@ def _collapse(xa: np.ndarray, P: np.ndarray, J: np.ndarray, h: np.ndarray, ok: n
 
 
 def diffuse_kalman_filter(model: LinearGaussianModel, y: Any, u: Any = None) -> DiffuseFilterResult:
-    r"""Filtre de Kalman **sans a priori** (départ diffus exact de Durbin & Koopman), par le filtre augmenté.
+    r"""Filtre de Kalman **sans a priori** (initialisation diffuse exacte de Durbin & Koopman), par le filtre augmenté.
 
     Paramètres
     ----------

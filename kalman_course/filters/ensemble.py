@@ -158,7 +158,7 @@ def ensemble_kalman_filter(
         ``f`` et ``h`` en un appel).
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante (ligne entière : prévision seule).
     x0 : (n,), P0 : (n, n) — loi de l'ensemble initial.
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     n_members : taille :math:`N \ge 2` de l'ensemble.
     rng : graine entière ou ``numpy.random.Generator`` (obligatoire).
     keep_members : garder l'ensemble analysé de chaque pas (``members`` (T, N, n)).

@@ -2,9 +2,9 @@ r"""Deux options du filtre de Kalman pour le pistage : la **porte** (rejet des m
 **mémoire évanescente** (oubli du passé).
 
 **Porte** (*gating*). Sous les hypothèses du filtre, l'innovation :math:`\nu_k = y_k - C\hat x_{k\mid k-1}`
-suit :math:`\mathcal N(0, S_k)`, donc le NIS :math:`\epsilon_k = \nu_k^TS_k^{-1}\nu_k` suit une loi du
+suit :math:`\mathcal N(0, S_k)`, donc la NIS :math:`\epsilon_k = \nu_k^TS_k^{-1}\nu_k` suit une loi du
 :math:`\chi^2` à :math:`m_k` degrés de liberté (:math:`m_k` : composantes observées au pas :math:`k`).
-Avec ``gate=p``, une mesure dont le NIS dépasse le quantile :math:`\chi^2_{m_k}(p)` est **rejetée** : le pas
+Avec ``gate=p``, une mesure dont la NIS dépasse le quantile :math:`\chi^2_{m_k}(p)` est **rejetée** : le pas
 se réduit à la prédiction. Sur des données conformes au modèle, une proportion :math:`1 - p` des mesures
 est rejetée à tort ; une mesure aberrante (à plusieurs :math:`\sqrt{S}` de la prédiction) l'est toujours.
 

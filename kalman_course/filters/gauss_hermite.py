@@ -113,7 +113,7 @@ def gauss_hermite_kalman_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any,
     model : NonlinearModel à bruits additifs.
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante.
     x0 : (n,) ; P0 : (n, n) symétrique **définie** positive.
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     order : nombre :math:`p \ge 2` de nœuds par dimension (3 par défaut) ; les intégrales de polynômes de
         degré :math:`\le 2p - 1` sont exactes : la moyenne d'une :math:`h` de degré :math:`d` dès
         :math:`2p - 1 \ge d`, sa covariance (degré :math:`2d`) dès :math:`2p - 1 \ge 2d` — pour

@@ -364,7 +364,7 @@ class SigmaPointRule(GaussianRule):
 @dataclass(frozen=True)
 class SymmetricSigmaRule(SigmaPointRule):
     r"""Règle symétrique à :math:`2n` (ou :math:`2n + 1`) points : :math:`\hat x \pm s_i`, où :math:`s_i`
-    est la :math:`i`-ème **ligne** du facteur de Cholesky supérieur :math:`U` de :math:`cP`
+    est la **ligne** :math:`i` du facteur de Cholesky supérieur :math:`U` de :math:`cP`
     (:math:`U^TU = cP`, la convention de filterpy), précédés de :math:`\chi_0 = \hat x` si la règle a un
     point central. Une sous-classe donne :meth:`scale` (:math:`c`), :meth:`weights` et ``central``.
 
@@ -572,7 +572,7 @@ def gaussian_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = No
     model : NonlinearModel (bruits additifs pour une règle à points).
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante.
     x0 : (n,) ; P0 : (n, n) (définie positive pour une règle à points).
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     rule : la règle d'intégration.
     redraw : ``True`` : la correction tire de nouveaux points de :math:`(\hat x^-, P^-)` ; ``False`` :
         elle réutilise les points propagés par :math:`f` (sans effet pour la linéarisation).

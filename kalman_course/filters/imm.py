@@ -332,7 +332,7 @@ def imm_filter(models: Sequence[LinearGaussianModel], y: Any, x0: Any, P0: Any, 
     transition : (r, r) — ``transition[i, j]`` = P(régime j au pas k | régime i au pas k−1), lignes de
         somme 1.
     mu0 : (r,), optionnel — probabilités des régimes avant la première mesure (uniformes par défaut).
-    u : (T, p), optionnel — commandes, communes aux régimes.
+    u : (T, p), optionnel — commandes, communes aux régimes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
 
     Renvoie un :class:`IMMResult` : ``x`` (T, n), ``P`` (T, n, n) combinés, ``mu`` (T, r), ``mu_pred``,
     ``x_modes`` (T, r, n), ``P_modes`` (T, r, n, n). Avec un seul régime, c'est

@@ -215,11 +215,12 @@ def kalman_filter(
         (gain nul). Une ligne partiellement manquante n'utilise que ses composantes présentes.
     x0 : (n,) — :math:`\hat x_0` (scalaire accepté si n = 1).
     P0 : (n, n) — :math:`P_0`, symétrique semi-définie positive (scalaire accepté si n = 1).
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes (exige un modèle avec ``B``).
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (exige un modèle avec ``B`` ;
+        ``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     form : ``"square_root"`` (par défaut : racine carrée de :math:`P`, sûre pour un :math:`P_0` vague),
         ``"textbook"`` (:math:`P = (I - KC)P^-`, la formule du cours) ou ``"joseph"`` — voir l'en-tête
         du module.
-    gate : probabilité :math:`0 < p < 1`, optionnelle — **porte** : une mesure dont le NIS
+    gate : probabilité :math:`0 < p < 1`, optionnelle — **porte** : une mesure dont la NIS
         :math:`\nu_k^TS_k^{-1}\nu_k` dépasse le quantile :math:`\chi^2_{m_k}(p)` (:math:`m_k` composantes
         observées) est rejetée et le pas se réduit à la prédiction (:mod:`~kalman_course.filters.gating`).
         Un pas rejeté garde son innovation et sa covariance ``S`` (son NIS se lit par
@@ -437,7 +438,7 @@ def _faded(predict, alpha2: float, square_root: bool):
 
 
 def _gated(update, p_gate: float, square_root: bool):
-    r"""Correction derrière une porte : si le NIS :math:`\nu^TS^{-1}\nu` dépasse :math:`\chi^2_{m_k}(p)`, la
+    r"""Correction derrière une porte : si la NIS :math:`\nu^TS^{-1}\nu` dépasse :math:`\chi^2_{m_k}(p)`, la
     mesure est rejetée (état prédit inchangé, gain nul, ``n_iter`` = 0 : ``result.rejected``)."""
 
     def gated(model, state, y, idx):

@@ -113,8 +113,8 @@ def _residual(w: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 
 def multinomial_resample(weights: Any, u: Any) -> np.ndarray:
-    r"""Rééchantillonnage multinomial : :math:`N` tirages indépendants selon les poids, la :math:`k`-ième
-    copie est la particule :math:`F^{-1}(u_k)` (:math:`F` : fonction de répartition des poids).
+    r"""Rééchantillonnage multinomial : :math:`N` tirages indépendants selon les poids, la copie
+    :math:`k` est la particule :math:`F^{-1}(u_k)` (:math:`F` : fonction de répartition des poids).
 
     ``weights`` (N,) normalisés ; ``u`` (N,) uniformes dans [0, 1). Renvoie les indices (N,) (entiers)."""
     w = _check_weights(weights)
@@ -433,7 +433,7 @@ def particle_filter(
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante (ligne entière : prédiction seule, poids
         inchangés ; ligne partielle : vraisemblance des seules composantes observées).
     x0 : (n,), P0 : (n, n) semi-définie positive — loi des particules initiales.
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     n_particles : nombre de particules :math:`N` (entier ≥ 1).
     rng : graine entière ou ``numpy.random.Generator`` (obligatoire : même graine → même résultat).
     resampling : ``"systematic"`` (défaut), ``"stratified"``, ``"residual"`` ou ``"multinomial"``.

@@ -139,7 +139,7 @@ def iterated_posterior_linearization_filter(
     model : NonlinearModel (bruits additifs pour une règle à points).
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante.
     x0 : (n,) ; P0 : (n, n) symétrique **définie** positive.
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     rule : la règle d'intégration (cubature par défaut ; ``kc.Linearization()`` donne l'EKF itéré).
     max_iter, tol : au plus ``max_iter`` régressions par correction ; arrêt quand le pas
         :math:`\lVert x_{i+1} - x_i\rVert` est au plus ``tol``.

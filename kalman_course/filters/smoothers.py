@@ -20,7 +20,7 @@ ne demande rien de particulier ; la commande est déjà dans les prédictions
 :math:`\hat x_{k+1\mid k}` du filtre.
 
 * :func:`rts_smoother` lisse un résultat de :func:`~kalman_course.kalman_filter` (:math:`A`) ou de
-  :func:`~kalman_course.filters.diffuse.diffuse_kalman_filter` (départ diffus exact) ;
+  :func:`~kalman_course.filters.diffuse.diffuse_kalman_filter` (initialisation diffuse exacte) ;
 * :func:`extended_rts_smoother` lisse un résultat de l'EKF (ou de l'EKF itéré) : :math:`A` devient la
   jacobienne :math:`F_k = \partial f/\partial x` en :math:`(\hat x_{k\mid k}, u)`, la prédiction du filtre ;
 * :func:`unscented_rts_smoother` lisse un résultat de l'UKF (Särkkä, 2008) : la covariance croisée
@@ -82,7 +82,7 @@ class SmootherResult:
     G_initial : (n, n) ou None
         Le gain qui relie l'état initial à la ligne 0.
     method : str
-        Le lisseur (« RTS », « RTS étendu », « RTS, départ diffus exact »…).
+        Le lisseur (« RTS », « RTS étendu », « RTS, initialisation diffuse exacte »…).
     """
 
     x: np.ndarray
@@ -138,8 +138,8 @@ def smoother_gains(P: np.ndarray, P_pred_next: np.ndarray, F: np.ndarray) -> np.
 def rts_pass(x: np.ndarray, P: np.ndarray, x_pred: np.ndarray, P_pred: np.ndarray, G: np.ndarray):
     r"""Passe arrière de RTS avec des gains ``G`` (T, n, n) déjà calculés (``G[T-1]`` ignoré).
 
-    ``x`` (T, n) — ou (T, n, c) : plusieurs moyennes filtrées ensemble, comme le filtre augmenté du
-    départ diffus — ``P`` (T, n, n), ``x_pred``, ``P_pred`` du filtre. Renvoie ``(xs, Ps, P_lag)`` ;
+    ``x`` (T, n) — ou (T, n, c) : plusieurs moyennes filtrées ensemble, comme le filtre augmenté de
+    l'initialisation diffuse — ``P`` (T, n, n), ``x_pred``, ``P_pred`` du filtre. Renvoie ``(xs, Ps, P_lag)`` ;
     ``P_lag[k]`` :math:`= P_{k\mid T}G_{k-1}^T` pour :math:`k \ge 1`, NaN en 0.
 
     Seule la récurrence est dans la boucle ; les lignes sont lues dans des listes de vues (pas d'indexation
@@ -207,7 +207,7 @@ def square_root_rts_pass(x: np.ndarray, P: np.ndarray, x_pred: np.ndarray, A: np
 
 
 def diffuse_rts_pass(A: np.ndarray, augmented: FilterResult, J: np.ndarray, h: np.ndarray):
-    r"""Lissage exact du départ diffus, sans vérification (le noyau de :func:`rts_smoother` pour un
+    r"""Lissage exact de l'initialisation diffuse, sans vérification (le noyau de :func:`rts_smoother` pour un
     :class:`~kalman_course.filters.diffuse.DiffuseFilterResult`, appelé tel quel par l'étape E d'EM, qui
     filtre elle-même et n'a rien à vérifier).
 
@@ -380,11 +380,11 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
     model : LinearGaussianModel — celui du filtre.
     result : FilterResult de :func:`~kalman_course.kalman_filter` (mesures manquantes et commandes
         comprises), ou :class:`~kalman_course.filters.diffuse.DiffuseFilterResult` de
-        :func:`~kalman_course.diffuse_kalman_filter` (départ diffus exact, voir plus bas).
+        :func:`~kalman_course.diffuse_kalman_filter` (initialisation diffuse exacte, voir plus bas).
     x0 : (n,), P0 : (n, n), optionnels — l'a priori donné au filtre : l'état initial (instant 0) est
         alors lissé aussi (``x_initial``, ``P_initial``, ``G_initial``, ``P_lag[0]``).
 
-    Départ diffus : sachant :math:`\delta` (l'état de la première mesure), le filtre augmenté est un
+    Initialisation diffuse : sachant :math:`\delta` (l'état de la première mesure), le filtre augmenté est un
     filtre ordinaire ; on lisse ses moyennes :math:`[a \mid X]` (affines en :math:`\delta`) et sa
     covariance, puis on intègre :math:`\delta \sim \mathcal N(J_T^{-1}h_T, J_T^{-1})` :
     :math:`\hat x_{k\mid T} = a^s_k + X^s_kJ_T^{-1}h_T`,
@@ -450,7 +450,7 @@ def _check_dimensions(result: FilterResult, n: int, m: int) -> None:
 def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> SmootherResult:
     if model.time_varying:
         raise KalmanInputError(
-            "rts_smoother : le lissage d'un départ diffus n'est écrit que pour un modèle constant ; pour un "
+            "rts_smoother : le lissage d'une initialisation diffuse n'est écrit que pour un modèle constant ; pour un "
             "modèle variable dans le temps, filtrez avec un a priori (kalman_filter(model, y, x0, P0))."
         )
     aug = result.augmented
@@ -459,7 +459,7 @@ def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> Smo
     A = model.A
     x_next = np.einsum("ij,tjc->tic", A, aug.x[:-1]) if model.B is None else None
     _check_consistency(aug, symmetrize(A @ aug.P[:-1] @ A.T + model.Q), x_next, model.C, model.R,
-                       "filtre de Kalman à départ diffus", " (diffuse_kalman_filter)")
+                       "filtre de Kalman à initialisation diffuse", " (diffuse_kalman_filter)")
     J, h = result.information[-1], result.information_vector[-1]
     if not is_determined(J):
         raise KalmanInputError(
@@ -473,7 +473,7 @@ def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> Smo
     ok = np.isfinite(result.P[:-1]).all(axis=(1, 2))
     if ok.any():
         G[:-1][ok] = smoother_gains(result.P[:-1][ok], result.P_pred[1:][ok], A)
-    return SmootherResult(xs, Ps, G, lag, method="RTS, départ diffus exact")
+    return SmootherResult(xs, Ps, G, lag, method="RTS, initialisation diffuse exacte")
 
 
 def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any = None, P0: Any = None,
@@ -505,7 +505,7 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
     model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
     result = _check_result(result)
     if isinstance(result, DiffuseFilterResult):
-        raise KalmanInputError("« result » vient du filtre à départ diffus (linéaire) : lissez-le avec rts_smoother.")
+        raise KalmanInputError("« result » vient du filtre à initialisation diffuse (linéaire) : lissez-le avec rts_smoother.")
     n, m, T = model.n_state, model.n_obs, result.n_steps
     _check_dimensions(result, n, m)
     _check_finite(result)

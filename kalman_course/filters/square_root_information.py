@@ -82,7 +82,7 @@ class SquareRootInformation(NamedTuple):
 class SrifUpdate(NamedTuple):
     r"""Résultat de :func:`srif_update` : ``R`` (n, n), ``z`` (n,) a posteriori, et ``residual`` (m,) =
     :math:`z_r`, dont la norme au carré :math:`\lVert z_r\rVert^2` est la somme des carrés des résidus
-    blanchis (égale au NIS :math:`\nu^TS^{-1}\nu` quand l'a priori est de rang plein). Seule la norme de
+    blanchis (égale à la NIS :math:`\nu^TS^{-1}\nu` quand l'a priori est de rang plein). Seule la norme de
     :math:`z_r` a un sens (la QR la concentre sur la première composante)."""
 
     R: np.ndarray
@@ -488,7 +488,7 @@ def square_root_information_filter(
     model : LinearGaussianModel
     y : (T, m), ou (T,) si m = 1 — ``NaN``/``None`` : composante manquante.
     x0 : (n,), P0 : (n, n) définie positive — optionnels, ensemble.
-    u : (T, p), ou (T,) si p = 1, optionnel.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     R0 : (n, n) triangulaire supérieure, z0 : (n,) — optionnels, ensemble.
     method : ``"inverse"`` (défaut, :math:`A` inversible) ou ``"joint"`` (sans :math:`A^{-1}`, :math:`Q`
         définie positive), voir :func:`srif_predict`.
@@ -556,7 +556,7 @@ def _require_state(R: np.ndarray, z: np.ndarray, what: str) -> np.ndarray:
     if information_rank(R) < R.shape[0]:
         raise KalmanInputError(
             f"Le SRIF étendu linéarise autour de {what} : il faut une information de rang plein "
-            "(« R_xx » inversible), donc un a priori (x0, P0) ; un départ diffus n'est possible qu'en linéaire."
+            "(« R_xx » inversible), donc un a priori (x0, P0) ; une initialisation diffuse n'est possible qu'en linéaire."
         )
     return _state(R, z)[0]
 

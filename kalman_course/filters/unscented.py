@@ -9,7 +9,7 @@ moyenne :math:`\bar x` et de covariance :math:`P` :
     \lambda = \alpha^2(n + \kappa) - n,\qquad
     \chi_0 = \bar x,\quad \chi_i = \bar x + s_i,\quad \chi_{n+i} = \bar x - s_i\quad (i = 1\dots n),
 
-où :math:`s_i` est la :math:`i`-ème **ligne** du facteur de Cholesky supérieur :math:`U` de
+où :math:`s_i` est la **ligne** :math:`i` du facteur de Cholesky supérieur :math:`U` de
 :math:`(n+\lambda)P` (:math:`U^TU = (n+\lambda)P`, comme ``MerweScaledSigmaPoints`` de filterpy), et les poids
 
 .. math::
@@ -277,7 +277,7 @@ def unscented_kalman_filter(
     y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante (ligne entière : prédiction seule ;
         ligne partielle : correction avec les seules composantes observées).
     x0 : (n,) ; P0 : (n, n) symétrique **définie** positive (les points sigma en prennent une racine).
-    u : (T, p), ou (T,) si p = 1, optionnel — commandes.
+    u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     alpha, beta, kappa : paramètres des points sigma de van der Merwe (sans valeur par défaut pour
         ``alpha`` et ``kappa`` : le bon choix dépend du problème ; :math:`\beta = 2` est optimal pour une
         loi gaussienne). :math:`\alpha = 1, \beta = 2, \kappa = 0` redonne exactement le filtre de Kalman

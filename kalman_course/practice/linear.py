@@ -400,13 +400,13 @@ NIS = Exercise(
     shapes_hint="innovations (T, m), S (T, m, m) ; eps (T,), une valeur par pas",
     mistakes=(
         Mistake("s-not-inverted", "νᵀ S ν au lieu de νᵀ S⁻¹ ν",
-                "Le NIS normalise l'innovation par sa covariance : ε = νᵀ S⁻¹ ν (`nu @ np.linalg.solve(S_k, nu)`). "
+                "La NIS normalise l'innovation par sa covariance : ε = νᵀ S⁻¹ ν (`nu @ np.linalg.solve(S_k, nu)`). "
                 "Avec S au lieu de S⁻¹, ε n'a plus la loi du χ² à m degrés de liberté.", _nis_s_not_inverted),
         Mistake("no-s", "S oubliée (νᵀ ν)",
                 "ε = νᵀ S⁻¹ ν : sans S, la taille de l'innovation n'est pas comparée à ce que le filtre attend, "
                 "et le test du χ² n'a plus de sens (unités, échelles).", _nis_no_s),
         Mistake("sum", "somme sur le temps au lieu d'une valeur par pas",
-                "La fonction doit renvoyer un NIS par pas, forme (T,) : la somme (ou la moyenne) se fait ensuite, "
+                "La fonction doit renvoyer une NIS par pas, forme (T,) : la somme (ou la moyenne) se fait ensuite, "
                 "pour le test du χ² à T m degrés de liberté.", _nis_sum,
                 detect=lambda outs, case: outs[0].shape == () and close(outs[0], case.expected[0].sum())),
         Mistake("diagonal-only", "seulement la diagonale de S",

@@ -1,4 +1,4 @@
-r"""Scénario « départ diffus » (SRIF) : une cible plane à vitesse constante, des relevés de position au
+r"""Scénario « initialisation diffuse » (SRIF) : une cible plane à vitesse constante, des relevés de position au
 millimètre, **aucun a priori** sur l'état initial.
 
 État :math:`x = [p_x, p_y, v_x, v_y]` (m, m/s), mesure :math:`y = [p_x, p_y] + \psi`, :math:`\sigma = 1` mm,

@@ -218,7 +218,7 @@ def lost_track_time(result: FilterResult, track: HelicopterTrack, run: int = 5) 
 class GateStudy:
     r"""La porte sur le vol (positions seules, paramètres appris).
 
-    ``exceed_99``, ``exceed_999`` : part des positions dont le NIS du filtre **sans porte** dépasse le
+    ``exceed_99``, ``exceed_999`` : part des positions dont la NIS du filtre **sans porte** dépasse le
     quantile 0,99 et 0,999 de :math:`\chi^2_2` ; ``rejected_999`` : positions rejetées par la porte
     :math:`p = 0{,}999` sur les données propres ; ``outliers_rejected`` : les positions corrompues rejetées
     (sur :data:`OUTLIER_ROWS`) ; ``other_rejected`` : autres positions rejetées dans cette expérience ;

@@ -10,7 +10,7 @@ aléatoire, la mesure est le niveau plus un bruit,
     y_t = \mu_t + \varepsilon_t,\ \ \varepsilon_t \sim \mathcal N(0, \sigma^2_\varepsilon),
 
 soit :math:`A = C = 1`, :math:`Q = \sigma^2_\eta`, :math:`R = \sigma^2_\varepsilon`, sans a priori sur le
-niveau de 1871 (départ diffus exact). Les paramètres sont :math:`\theta = (\log\sigma^2_\varepsilon,
+niveau de 1871 (initialisation diffuse exacte). Les paramètres sont :math:`\theta = (\log\sigma^2_\varepsilon,
 \log\sigma^2_\eta)` : les variances restent positives sans contrainte.
 
 Toutes les fonctions sont à résultat mis en cache : le chapitre, ses figures et ses tests partagent
@@ -97,7 +97,7 @@ def local_linear_trend_model(sigma2_eps: float, sigma2_level: float, sigma2_slop
 
 @lru_cache(maxsize=2)
 def nile_fit(missing: bool = False) -> MaximumLikelihood:
-    r"""Maximum de vraisemblance (départ diffus exact) du niveau local sur le Nil (``missing`` : version à
+    r"""Maximum de vraisemblance (initialisation diffuse exacte) du niveau local sur le Nil (``missing`` : version à
     années manquantes), en partant de :data:`NILE_THETA0`."""
     return maximum_likelihood(local_level_from_log, nile(missing).flow, np.array(NILE_THETA0))
 
@@ -105,7 +105,7 @@ def nile_fit(missing: bool = False) -> MaximumLikelihood:
 @dataclass(frozen=True, eq=False)
 class NileSmoothing:
     """Le Nil filtré et lissé : ``data`` (:class:`~kalman_course.datasets.AnnualSeries`), ``model``,
-    ``filtered`` (départ diffus exact), ``smoothed``."""
+    ``filtered`` (initialisation diffuse exacte), ``smoothed``."""
 
     data: AnnualSeries
     model: LinearGaussianModel
@@ -144,7 +144,7 @@ class LikelihoodSurface:
 
 @lru_cache(maxsize=2)
 def likelihood_surface(n: int = 25, missing: bool = False) -> LikelihoodSurface:
-    r""":math:`\log L(\sigma^2_\varepsilon, \sigma^2_\eta)` (départ diffus exact) sur une grille log de
+    r""":math:`\log L(\sigma^2_\varepsilon, \sigma^2_\eta)` (initialisation diffuse exacte) sur une grille log de
     ``n`` × ``n`` points : :math:`\sigma^2_\varepsilon \in [10^{3}, 10^{5}]`, :math:`\sigma^2_\eta \in [10^{1}, 10^{5}]`."""
     y = nile(missing).flow
     eps = np.logspace(3.0, 5.0, n)
@@ -155,7 +155,7 @@ def likelihood_surface(n: int = 25, missing: bool = False) -> LikelihoodSurface:
 
 @lru_cache(maxsize=2)
 def nile_em(missing: bool = False, max_iter: int = 2000, tol: float = 1e-12) -> EMResult:
-    """EM sur le Nil (départ diffus exact) depuis :data:`NILE_EM_START`."""
+    """EM sur le Nil (initialisation diffuse exacte) depuis :data:`NILE_EM_START`."""
     return expectation_maximization(local_level_model(*NILE_EM_START), nile(missing).flow, max_iter=max_iter, tol=tol)
 
 
@@ -202,7 +202,7 @@ def diffuse_limit(kappas, variances=NILE_DK_VARIANCES) -> np.ndarray:
 
 def level_drop(smoothing: NileSmoothing | None = None) -> dict[str, float]:
     r"""La baisse du niveau lissé autour de 1899 : niveau lissé en 1894 et en 1903, et la plus forte baisse
-    d'une année sur l'autre (``year`` : l'année d'arrivée, ``drop`` : la baisse, :math:`10^8` m³)."""
+    d'une année sur l'autre (``year`` : l'année d'arrivée, ``drop`` : la baisse, :math:`10^8` m³ par an)."""
     run = nile_smoothing(False) if smoothing is None else smoothing
     level = run.smoothed.x[:, 0]
     years = run.data.year
@@ -220,7 +220,7 @@ def missing_years_coverage() -> dict[str, float]:
     r"""Les 40 débits retirés (version à années manquantes) contre la prévision du lisseur : la mesure
     d'une année retirée suit :math:`\mathcal N(\hat\mu_{t\mid T}, P_{t\mid T} + \sigma^2_\varepsilon)`.
     Renvoie la part des débits retirés dans l'intervalle à ± 2 écarts-types (``inside``), l'erreur
-    quadratique moyenne du niveau lissé sur ces années (``rmse``, :math:`10^8` m³) et l'écart-type de
+    quadratique moyenne du niveau lissé sur ces années (``rmse``, :math:`10^8` m³ par an) et l'écart-type de
     prévision moyen (``sd``)."""
     run = nile_smoothing(True)
     full = nile(False).flow
