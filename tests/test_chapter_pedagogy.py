@@ -1,6 +1,6 @@
 """La structure pédagogique de chaque page du livre (sans construction) : objectifs et prérequis en tête,
 « À retenir » à la fin, un quiz de 3 à 5 questions, une figure à curseurs avec son encadré « À observer »
-et ses curseurs vivants montrés en code ; et les réponses chiffrées des quiz recalculées par le paquet."""
+et ses curseurs interactifs montrés en code ; et les réponses chiffrées des quiz recalculées par le paquet."""
 
 from __future__ import annotations
 
@@ -116,7 +116,7 @@ _LEGACY = {"voltage": "tension-curseurs", "tag": "tag-curseurs", "nile": "nil-cu
            "particle": "filtre-particulaire-curseurs", "banana_uncertainty": "ukf-banane-incertitude",
            "banana_parameter": "ukf-banane-parametres"}
 _SHOWN = re.compile(r'kc\.interactive\.(?:sliders\("([^"]+)"\)|(' + "|".join(_LEGACY) + r')_sliders\(\))')
-#: Curseurs vivants des figures d'avant le registre, sous leur propre nom.
+#: Curseurs interactifs des figures d'avant le registre, sous leur propre nom.
 _LIVE = {"tension-curseurs": "live_voltage_explorer()", "tag-curseurs": "live_tag_explorer()",
          "nil-curseurs": "live_nile_explorer()"}
 
@@ -139,10 +139,10 @@ def test_page_shows_its_slider_figures_each_with_an_observation_box_and_live_cod
         items = re.findall(r"^(?:\d\.|-) ", outside, re.M)
         explained = re.findall(r"\{dropdown\}|:class: dropdown", box.group(2))
         assert 2 <= len(items) <= 4 and explained, f"{page} : {name}, deux à quatre essais, expliqués en dépliant"
-        # les curseurs vivants (Jupyter) sont montrés en code à recopier, jamais exécutés dans le livre
+        # les curseurs interactifs (Jupyter) sont montrés en code à recopier, jamais exécutés dans le livre
         live = _LIVE.get(name, f'live_explorer("{name}")')
         blocks = re.findall(r"```python\n(.*?)```", text, re.S)
-        assert any(live in b for b in blocks), f"{page} : curseurs vivants de {name} non montrés"
+        assert any(live in b for b in blocks), f"{page} : curseurs interactifs de {name} non montrés"
 
 
 def test_intuition_is_the_first_chapter_and_marked_as_an_addition():

@@ -1,5 +1,5 @@
 """Interactivité : grilles précalculées (contre kalman_filter et filterpy), figure Bokeh (données exactes
-dans le HTML), curseurs vivants ipywidgets pilotés depuis Python, extension Sphinx, entrées invalides."""
+dans le HTML), curseurs interactifs ipywidgets pilotés depuis Python, extension Sphinx, entrées invalides."""
 
 from __future__ import annotations
 
@@ -226,7 +226,7 @@ def test_static_figure_tells_jupyter_users_where_the_live_sliders_are():
     assert 'class="kc-bokeh-missing"' in html
 
 
-# --------------------------------------------------------------------------- curseurs vivants (ipywidgets)
+# --------------------------------------------------------------------------- curseurs interactifs (ipywidgets)
 
 
 def test_live_sliders_are_log_sliders_with_real_values():
@@ -292,7 +292,7 @@ def test_no_kernel_widget_is_executed_in_the_book():
         cells = re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", md.read_text(), re.S)
         for cell in cells:
             live = re.search(r"live_\w*explorer\s*\(|import ipywidgets|from ipywidgets|\binteract\(", cell)
-            assert live is None, f"{md.name} : cellule à widget vivant ({live and live[0]})"
+            assert live is None, f"{md.name} : cellule à widget interactif ({live and live[0]})"
 
 
 # --------------------------------------------------------------------------- extension Sphinx

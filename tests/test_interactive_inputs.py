@@ -45,7 +45,7 @@ AXIS = dict(name="a", symbol="a", description="un axe", unit="m")
         (lambda: ki.Glyph("x", "band", "red", "bande"), "upper"),
         (lambda: ki.Glyph("x", "line", "red", "x", dash="pointillé"), "dash"),
         (lambda: ki.Glyph("x", "scatter", "red", "x", marker="cœur"), "marker"),
-        # registre et curseurs vivants
+        # registre et curseurs interactifs
         (lambda: ki.sliders("pas-une-figure"), "Figure à curseurs inconnue"),
         (lambda: SliderSpec("n", "c", "t", "x (m)", axes=(), run=lambda: {}, time=[0.0], panels=()), "un à trois"),
         (lambda: ki.LinearParameter("K", "gain", "", 3.0, 0.0, 2.0, 0.1), "hors de la plage"),

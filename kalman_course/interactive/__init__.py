@@ -1,4 +1,4 @@
-"""Interactivité du cours : curseurs statiques (livre publié, sans noyau) et vivants (Jupyter).
+"""Interactivité du cours : curseurs statiques (livre publié, sans noyau) et interactifs (Jupyter).
 
 Chaque chapitre a au moins une figure à curseurs, décrite une fois (:class:`SliderSpec`, inscrite au
 registre par :func:`register_sliders`) et rendue de deux façons :

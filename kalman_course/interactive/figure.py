@@ -1,4 +1,4 @@
-r"""Le registre des figures à curseurs : une description par figure, deux rendus (statique et vivant).
+r"""Le registre des figures à curseurs : une description par figure, deux rendus (statique et interactif).
 
 Chaque chapitre décrit sa figure interactive **une fois** par une :class:`SliderSpec` : les axes des
 curseurs (:class:`~.grid.ParameterAxis`), la fonction ``run`` qui calcule une exécution par le paquet
@@ -8,12 +8,12 @@ donne :
 
 - la **figure statique** du livre publié (:meth:`SliderSpec.static`, Bokeh, toutes les exécutions
   précalculées sur la grille, aucun noyau) ;
-- les **curseurs vivants** de Jupyter (:meth:`SliderSpec.live`, ipywidgets, le filtre relancé pour
+- les **curseurs interactifs** de Jupyter (:meth:`SliderSpec.live`, ipywidgets, le filtre relancé pour
   n'importe quelle valeur).
 
 Une fonction ``() -> SliderSpec`` s'inscrit au registre par :func:`register_sliders` ; un chapitre
 affiche sa figure par ``kc.interactive.sliders("nom")``, et ``kc.interactive.live_explorer("nom")``
-donne les curseurs vivants.
+donne les curseurs interactifs.
 """
 
 from __future__ import annotations
@@ -78,7 +78,7 @@ class SliderSpec:
 
     @property
     def live_hint(self) -> str:
-        """L'appel qui donne les curseurs vivants dans Jupyter."""
+        """L'appel qui donne les curseurs interactifs dans Jupyter."""
         return f'kc.interactive.live_explorer("{self.name}")'
 
     def grid(self) -> ParameterGrid:
@@ -110,7 +110,7 @@ class SliderSpec:
         )
 
     def live_parameters(self) -> tuple:
-        """Les curseurs vivants équivalents aux axes : logarithmique, linéaire ou à positions."""
+        """Les curseurs interactifs équivalents aux axes : logarithmique, linéaire ou à positions."""
         from .live import ChoiceParameter, LinearParameter, LogParameter
 
         out = []
@@ -130,7 +130,7 @@ class SliderSpec:
         return tuple(out)
 
     def live(self):
-        """Les curseurs vivants (ipywidgets) : ``run`` relancé à chaque relâchement (noyau requis)."""
+        """Les curseurs interactifs (ipywidgets) : ``run`` relancé à chaque relâchement (noyau requis)."""
         from .live import LiveExplorer
 
         names = [axis.name for axis in self.axes]
@@ -195,7 +195,7 @@ def sliders(name: str):
 
 
 def live_explorer(name: str):
-    """Les curseurs vivants de la figure ``name`` (Jupyter, Binder, Colab : un noyau doit tourner)."""
+    """Les curseurs interactifs de la figure ``name`` (Jupyter, Binder, Colab : un noyau doit tourner)."""
     return slider_spec(name).live()
 
 

@@ -1,4 +1,4 @@
-r"""Curseurs vivants (ipywidgets) : relancent le filtre du paquet à chaque relâchement de curseur.
+r"""Curseurs interactifs (ipywidgets) : relancent le filtre du paquet à chaque relâchement de curseur.
 
 À utiliser dans Jupyter, sur Binder ou sur Colab (un noyau Python doit tourner). Les curseurs sont
 logarithmiques (``FloatLogSlider``) et affichent la vraie valeur du paramètre ; ``continuous_update``
@@ -287,4 +287,4 @@ class LiveExplorer:
 
     def __repr__(self) -> str:
         values = " ; ".join(f"{k} = {format_spec(v, '.3g')}" for k, v in self.values().items())
-        return f"<Curseurs vivants ({values}) : exige un noyau Jupyter en marche>"
+        return f"<Curseurs interactifs ({values}) : exige un noyau Jupyter en marche>"

@@ -3,7 +3,7 @@ Kalman *unscented* (UKF) », « Le filtre particulaire » et « Lissage ».
 
 Chaque entrée reprend les axes, la fonction d'une exécution, les panneaux et les séries fixes de la
 figure d'origine (:mod:`.unscented`, :mod:`.particle`, :mod:`.smoothing`) : même grille, mêmes tracés ;
-le registre y ajoute les curseurs vivants (``kc.interactive.live_explorer("nom")``) et les tests
+le registre y ajoute les curseurs interactifs (``kc.interactive.live_explorer("nom")``) et les tests
 communs à toutes les figures.
 """
 

@@ -98,7 +98,7 @@ def _positive(name: str, value) -> float:
 
 
 def live_nile_explorer(R: float = NILE_DK_VARIANCES[0], Q: float = NILE_DK_VARIANCES[1]):
-    r"""Curseurs vivants (ipywidgets) :math:`R` et :math:`Q` sur le Nil à années manquantes, pour Jupyter,
+    r"""Curseurs interactifs (ipywidgets) :math:`R` et :math:`Q` sur le Nil à années manquantes, pour Jupyter,
     Binder ou Colab (un noyau doit tourner). Renvoie un :class:`~.live.LiveExplorer`."""
     from .live import LiveExplorer, LogParameter
 

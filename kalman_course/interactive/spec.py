@@ -1,5 +1,5 @@
 """Description des panneaux d'une figure interactive, commune aux curseurs statiques (Bokeh) et
-vivants (matplotlib + ipywidgets) : un chapitre décrit sa figure une fois, les deux la dessinent."""
+interactifs (matplotlib + ipywidgets) : un chapitre décrit sa figure une fois, les deux la dessinent."""
 
 from __future__ import annotations
 
@@ -315,7 +315,7 @@ def fill_glyph(ax, glyph: Glyph, data, label=None):
 def draw_panels(panels, data, x_label: str, *, height_px_per_inch: float = 80.0):
     """Dessine les panneaux avec matplotlib (sans pyplot), un sous-graphique par panneau.
 
-    Sert aux curseurs vivants (:mod:`.live`, figure redessinée à chaque mouvement) et à l'image fixe
+    Sert aux curseurs interactifs (:mod:`.live`, figure redessinée à chaque mouvement) et à l'image fixe
     des curseurs statiques (:mod:`.static`, figure du PDF à la position par défaut des curseurs).
 
     Paramètres

@@ -10,7 +10,7 @@ donc à la même version). L'extension Sphinx :mod:`kalman_course.sphinx.sliders
 balises ``<script>`` dans l'en-tête des seules pages qui contiennent une telle figure (repérées par
 l'attribut :data:`MARKER`), une fois par page, avec un chemin relatif qui marche en ``http://`` comme
 en ``file://``. Hors du livre (dans Jupyter), la figure affiche un message qui renvoie vers les
-curseurs vivants (:mod:`kalman_course.interactive.live`).
+curseurs interactifs (:mod:`kalman_course.interactive.live`).
 
 Le PDF du cours (constructeur LaTeX) ne peut pas animer de curseurs : la figure fournit aussi une
 image PNG (matplotlib, mêmes panneaux, exécution de la position par défaut des curseurs) et une
@@ -161,7 +161,7 @@ class StaticSliders:
     title : str
         Titre affiché au-dessus des curseurs.
     live_hint : str
-        L'appel qui donne les curseurs vivants équivalents dans Jupyter (cité hors du livre).
+        L'appel qui donne les curseurs interactifs équivalents dans Jupyter (cité hors du livre).
     readout : fonction ``index -> str``, optionnelle
         Le texte affiché sous les curseurs au point de grille ``index`` (tuple d'indices) : les
         nombres de cette exécution, écrits en français (:func:`kalman_course.numbers.format_number`).
@@ -515,7 +515,7 @@ class StaticSliders:
         # dans le livre, le script l'efface avant d'insérer la figure.
         missing = (
             "Figure à curseurs précalculés : elle s’affiche dans le livre publié, qui sert BokehJS. "
-            f"Dans Jupyter, utilisez les curseurs vivants{hint}."
+            f"Dans Jupyter, utilisez les curseurs interactifs{hint}."
         )
         title = html.escape(french_spacing(self.title or f"Figure à curseurs « {self.name} »"))
         texts = getattr(self, "_texts", [])

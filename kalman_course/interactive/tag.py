@@ -108,7 +108,7 @@ def _check_positive(name: str, value) -> float:
 
 
 def live_tag_explorer(accel_std: float = TAG_ACCEL_STD, range_std: float = TAG_RANGE_STD):
-    r"""Curseurs vivants (ipywidgets) :math:`\sigma_a`, :math:`\sigma_r` : relancent l'EKF (noyau requis)."""
+    r"""Curseurs interactifs (ipywidgets) :math:`\sigma_a`, :math:`\sigma_r` : relancent l'EKF (noyau requis)."""
     from .live import LiveExplorer, LogParameter
 
     data = tag_data()

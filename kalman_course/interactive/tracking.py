@@ -3,7 +3,7 @@ r"""Curseurs des chapitres de pistage.
 * « Plusieurs capteurs, temps irrégulier » — la **porte** (probabilité :math:`p`) et la **densité**
   :math:`q` du filtre sur l'hélicoptère SAMU 31, dont six positions ont été corrompues
   (:mod:`kalman_course.scenarios.helicopter`) : la trajectoire estimée et ses ellipses dans le plan, les
-  positions rejetées, le NIS de chaque position et le seuil de la porte.
+  positions rejetées, la NIS de chaque position et le seuil de la porte.
 * « Cibles qui manœuvrent » — le **facteur d'oubli** :math:`\alpha` sur la cible simulée qui vire, et
   l'**IMM** : probabilité de changer de régime et densités des deux régimes
   (:mod:`kalman_course.scenarios.manoeuvre`).

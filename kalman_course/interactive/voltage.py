@@ -1,4 +1,4 @@
-r"""Curseurs du chapitre « tension constante » : :math:`\Phi` et :math:`\Psi` (statiques et vivants).
+r"""Curseurs du chapitre « tension constante » : :math:`\Phi` et :math:`\Psi` (statiques et interactifs).
 
 Même scénario que les figures du chapitre (:mod:`kalman_course.figures.voltage`) : 50 relevés à graine
 fixe, :math:`\hat x_0 = 0`, :math:`P_0 = 1` V². La position par défaut des curseurs,
@@ -129,7 +129,7 @@ def voltage_sliders(n_steps: int = 50, per_decade: int = 2):
 
 
 def live_voltage_explorer(Q: float = VOLTAGE_Q, R: float = VOLTAGE_R, P0: float = VOLTAGE_P0, n_steps: int = 50):
-    r"""Curseurs vivants (ipywidgets) :math:`\Phi`, :math:`\Psi`, :math:`P_0` pour Jupyter, Binder ou Colab.
+    r"""Curseurs interactifs (ipywidgets) :math:`\Phi`, :math:`\Psi`, :math:`P_0` pour Jupyter, Binder ou Colab.
 
     Chaque relâchement d'un curseur relance :func:`~kalman_course.kf.kalman_filter` et redessine
     l'estimation, :math:`P_n` et :math:`K_n`. Exige un noyau Python en marche : dans le livre publié,
