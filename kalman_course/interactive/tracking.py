@@ -116,7 +116,7 @@ def gate_spec() -> SliderSpec:
                 Glyph("est_n", "line", "darkorange", "estimation", x="est_e", width=1.8),
                 Glyph("rej_n", "scatter", "black", "positions rejetées", x="rej_e", marker="circle", size=7),
             ), x_label="est (km)", x_range=(-1.5, 5.5), y_range=Follow(aspect=7.0 / 7.8, margin=0.04),
-                equal_aspect=True, width=460, height=420),  # une piste perdue part loin : le plan la suit
+                equal_aspect=True, width=400, height=370),  # une piste perdue part loin : le plan la suit
             Panel("NIS de chaque position et seuil de la porte", "NIS (sans unité)", (
                 Glyph("nis", "scatter", "darkorange", "NIS", marker="dot", size=6),
                 Glyph("threshold", "line", "black", "seuil χ²₂(p)", dash="dashed", width=1.5),
