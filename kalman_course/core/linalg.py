@@ -24,8 +24,8 @@ import scipy.linalg
 from .validation import KalmanInputError
 
 __all__ = [
-    "symmetrize", "psd_solve", "kalman_gain", "correct", "correct_many", "cholesky_factor", "covariance_factor",
-    "covariance_root", "triangular_root", "correct_square_root", "centred_rows", "weighted_rows",
+    "symmetrize", "psd_solve", "is_positive_definite", "kalman_gain", "correct", "correct_many", "cholesky_factor",
+    "covariance_factor", "covariance_root", "triangular_root", "correct_square_root", "centred_rows", "weighted_rows",
 ]
 
 _posv, _geqrf, _trtri = scipy.linalg.get_lapack_funcs(("posv", "geqrf", "trtri"), dtype=np.float64)
@@ -69,13 +69,14 @@ def psd_solve(S: np.ndarray, B: np.ndarray, *, message: str = S_NOT_PD, where: s
     try:
         L = np.linalg.cholesky(S)
     except np.linalg.LinAlgError:
-        bad = next(i for i in range(S.shape[0]) if not _is_pd(S[i]))
+        bad = next(i for i in range(S.shape[0]) if not is_positive_definite(S[i]))
         place = ", ".join([name, f"tirage {bad}"] + ([where] if where else []))
         raise KalmanInputError(f"{message[:-1]} ({place}).") from None
     return np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, B))
 
 
-def _is_pd(M: np.ndarray) -> bool:
+def is_positive_definite(M: np.ndarray) -> bool:
+    """``M`` (n, n) est-elle définie positive (sa factorisation de Cholesky réussit-elle) ?"""
     try:
         np.linalg.cholesky(M)
     except np.linalg.LinAlgError:

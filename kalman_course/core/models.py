@@ -23,7 +23,7 @@ import numpy as np
 
 from .angles import wrap_angle
 from .jacobians import numerical_jacobian
-from .linalg import covariance_root
+from .linalg import is_positive_definite, covariance_root
 from .validation import (
     KalmanInputError,
     as_float_array,
@@ -249,19 +249,11 @@ def _each_step(name: str, value: Any, T: int | None, check: Callable[[str, Any],
             try:
                 np.linalg.cholesky(sym)
             except np.linalg.LinAlgError:
-                ok = np.array([_is_pd(M) for M in sym])
+                ok = np.array([is_positive_definite(M) for M in sym])
     if not ok.all():
         k = int(np.argmin(ok))
         check(f"{name}[{k}]", arr[k])  # lève l'erreur française de cette ligne
     return sym
-
-
-def _is_pd(M: np.ndarray) -> bool:
-    try:
-        np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        return False
-    return True
 
 
 def _constant_model(A, C, Q, R, B) -> LinearGaussianModel:

@@ -41,6 +41,15 @@ def _skipped_classes():
     )
 
 
+def _inside(node, classes) -> bool:
+    """``node`` ou l'un de ses ancêtres est-il de l'une des ``classes`` (code, formule, HTML brut…) ?"""
+    while node is not None:
+        if isinstance(node, classes):
+            return True
+        node = node.parent
+    return False
+
+
 def typeset(document) -> int:
     """Applique les règles à tous les nœuds de texte courant de ``document`` ; renvoie le nombre de
     nœuds modifiés. Un nœud dont un ancêtre est du code, une formule ou du HTML brut est laissé."""
@@ -52,13 +61,7 @@ def typeset(document) -> int:
         parent = node.parent
         if parent is None:
             continue
-        ancestor, skip = parent, False
-        while ancestor is not None:
-            if isinstance(ancestor, skipped):
-                skip = True
-                break
-            ancestor = ancestor.parent
-        if skip:
+        if _inside(parent, skipped):
             continue
         old = str(node)
         new = apply_rules(old)
@@ -110,13 +113,7 @@ def italicize_latin(document) -> int:
         parent = node.parent
         if parent is None or not _LATIN.search(str(node)):
             continue
-        ancestor, skip = parent, False
-        while ancestor is not None:
-            if isinstance(ancestor, skipped):
-                skip = True
-                break
-            ancestor = ancestor.parent
-        if skip:
+        if _inside(parent, skipped):
             continue
         pieces = []
         for i, part in enumerate(_LATIN.split(str(node))):
