@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["NBSP", "NNBSP", "apply_rules", "french_spacing"]
+__all__ = ["NBSP", "NNBSP", "LATIN", "apply_rules", "french_spacing", "italic_latin_html"]
 
 #: Espace insécable (avant « : », dans « »).
 NBSP = "\u00a0"
@@ -51,3 +51,13 @@ def french_spacing(text: str) -> str:
     module) ; les formules ``$…$`` ne sont pas modifiées."""
     parts = _MATH.split(text)
     return "".join(part if i % 2 else apply_rules(part) for i, part in enumerate(parts))
+
+
+#: Locutions latines composées en italique : *a priori*, *a posteriori*.
+LATIN = re.compile(r"(?<![\w-])(a (?:priori|posteriori))(?![\w-])")
+
+
+def italic_latin_html(escaped: str) -> str:
+    """Un texte HTML déjà échappé (titre de figure à curseurs, lecture chiffrée…) avec *a priori* et
+    *a posteriori* en italique (``<em>``), comme le texte courant du livre."""
+    return LATIN.sub(r"<em>\1</em>", escaped)

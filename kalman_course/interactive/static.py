@@ -44,7 +44,7 @@ from bokeh.models import (
 from bokeh.plotting import figure
 
 from ..core.validation import KalmanInputError, as_float_array
-from ..typography import french_spacing
+from ..typography import french_spacing, italic_latin_html
 from ..numbers import bokeh_tick_formatter
 from .grid import ParameterGrid
 from .spec import Panel, check_columns, panel_ranges, panel_y_range
@@ -517,11 +517,11 @@ class StaticSliders:
             "Figure à curseurs précalculés : elle s’affiche dans le livre publié, qui sert BokehJS. "
             f"Dans Jupyter, utilisez les curseurs interactifs{hint}."
         )
-        title = html.escape(french_spacing(self.title or f"Figure à curseurs « {self.name} »"))
+        title = italic_latin_html(html.escape(french_spacing(self.title or f"Figure à curseurs « {self.name} »")))
         texts = getattr(self, "_texts", [])
         default = int(np.ravel_multi_index(self.grid.default_index, self.grid.shape))
         readout = (f'<p class="kc-readout" id="{root_id}-readout" aria-live="polite">'
-                   f'{html.escape(texts[default])}</p>\n') if texts else ""
+                   f'{italic_latin_html(html.escape(texts[default]))}</p>\n') if texts else ""
         columns = self.columns
         sliders = "".join(f'<div class="kc-bokeh-slider" id="{root_id}-slider-{k}"></div>'
                           for k in range(len(self.grid.axes)))
@@ -531,7 +531,7 @@ class StaticSliders:
         panels = "".join(
             f'<div class="kc-bokeh-panel{" kc-bokeh-plane" if p.equal_aspect else ""}" id="{root_id}-panel-{k}-box" '
             f'role="figure" aria-label="{html.escape(self.panel_label(k), quote=True)}">'
-            f'<p class="kc-panel-title" aria-hidden="true">{html.escape(french_spacing(p.title))}</p>'
+            f'<p class="kc-panel-title" aria-hidden="true">{italic_latin_html(html.escape(french_spacing(p.title)))}</p>'
             f'<div class="kc-bokeh-canvas" id="{root_id}-panel-{k}"></div></div>'
             for k, p in enumerate(self.panels)
         )

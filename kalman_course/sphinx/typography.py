@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import re
 
-from ..typography import NBSP, apply_rules, french_spacing
+from ..typography import LATIN, NBSP, apply_rules, french_spacing
 
 __all__ = ["typeset", "italicize_latin", "quote_document_titles", "typeset_mermaid", "setup"]
 
@@ -95,8 +95,6 @@ def typeset_mermaid(document) -> int:
     return changed
 
 
-#: Locutions latines composées en italique dans le texte courant.
-_LATIN = re.compile(r"(?<![\w-])(a (?:priori|posteriori))(?![\w-])")
 #: La même, dans une étiquette HTML (Mermaid) : pas déjà entre ``<i>`` et ``</i>``.
 _LATIN_HTML = re.compile(r"(?<![\w-])(?<!<i>)(a (?:priori|posteriori))(?![\w-])")
 
@@ -111,12 +109,12 @@ def italicize_latin(document) -> int:
     changed = 0
     for node in list(document.findall(nodes.Text)):
         parent = node.parent
-        if parent is None or not _LATIN.search(str(node)):
+        if parent is None or not LATIN.search(str(node)):
             continue
         if _inside(parent, skipped):
             continue
         pieces = []
-        for i, part in enumerate(_LATIN.split(str(node))):
+        for i, part in enumerate(LATIN.split(str(node))):
             if i % 2:
                 pieces.append(nodes.emphasis(part, part))
                 changed += 1
