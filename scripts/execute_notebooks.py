@@ -1,9 +1,12 @@
 """Exécute en parallèle les carnets du livre absents du cache d'exécution, avant la construction.
 
 Jupyter Book 1 (myst-nb, ``execute_notebooks: cache``) exécute les carnets un par un, pendant la lecture
-des pages. Ce script les exécute avant, plusieurs à la fois (un noyau par processus), et les range dans
-le même cache (jupyter-cache, dont la clé est le code des cellules) : la construction qui suit les y
-trouve et n'en exécute aucun. Même lecture que la construction (le lecteur MyST de myst-nb), même
+des pages. Ce script les exécute avant, plusieurs à la fois, et les range dans le même cache
+(jupyter-cache, dont la clé est le code des cellules) : la construction qui suit les y trouve et n'en
+exécute aucun. Chaque processus de travail garde **un noyau** pour tous ses carnets : les modules importés
+(le paquet, scipy, matplotlib, Bokeh, 3 à 4 s par carnet) le restent, et avant chaque carnet le noyau est
+remis dans l'état d'un noyau neuf (espace de noms vidé, compteurs remis : voir ``_RESET``) ; les sorties
+sont celles d'un noyau neuf. Même lecture que la construction (le lecteur MyST de myst-nb), même
 exécution (``single_nb_execution`` de jupyter-cache, dans le dossier du carnet, délai de _config.yml,
 arrêt à la première erreur), même rangement. Un carnet en erreur n'est pas rangé : la construction le
 relance et échoue sur son erreur, trace comprise.
@@ -47,15 +50,69 @@ def _timeout(root: Path = ROOT) -> int:
     return int((config.get("execute") or {}).get("timeout", 30))
 
 
+#: Le noyau du processus de travail (démarré au premier carnet, arrêté à la sortie du processus).
+_KERNEL = None
+#: Au démarrage du noyau d'un processus de travail : les modules lourds importés une fois, et la valeur du
+#: compteur des identifiants Bokeh qu'a un noyau neuf après l'import de ``kalman_course.interactive``
+#: (seul module qui crée des objets Bokeh, dont quelques-uns à l'import).
+_WARM_UP = """\
+import bokeh.util.serialization as _ids
+import kalman_course.interactive
+_ids._kc_fresh_id = _ids._simple_id
+del _ids
+"""
+#: Avant chaque carnet, l'état d'un noyau neuf : espace de noms vidé, figures matplotlib fermées, compteurs
+#: des identifiants Bokeh et des exécutions remis à leur valeur de départ (les sorties sont celles d'un noyau
+#: neuf, octet pour octet), dossier du carnet.
+_RESET = """\
+%reset -f
+import os as _os, sys as _sys
+_sys.modules["matplotlib.pyplot"].close("all") if "matplotlib.pyplot" in _sys.modules else None
+_sys.modules["bokeh.util.serialization"]._simple_id = _sys.modules["bokeh.util.serialization"]._kc_fresh_id
+_os.chdir({cwd!r})
+del _os, _sys
+get_ipython().execution_count = 1  # celui de la première cellule du carnet
+"""
+
+
+def _kernel(cwd: str):
+    """Le noyau de ce processus de travail : un seul pour tous ses carnets, les modules déjà importés (le
+    paquet, scipy, matplotlib, Bokeh : 3 à 4 s par carnet) le restent ; l'espace de noms est vidé avant
+    chaque carnet (:data:`_RESET`). Les tirages aléatoires du livre ont tous leur graine : un carnet ne
+    dépend pas de ceux qui l'ont précédé dans le noyau."""
+    global _KERNEL
+    import nbformat
+    from nbclient import execute
+
+    if _KERNEL is not None and not _KERNEL.is_alive():  # noyau mort (carnet qui l'a fait tomber) : un neuf
+        _KERNEL = None
+    if _KERNEL is None:
+        from multiprocessing.util import Finalize
+
+        from jupyter_client.manager import start_new_kernel
+
+        # sans historique : le compteur d'exécution revient à 1 à chaque carnet
+        km, kc = start_new_kernel(kernel_name="python3", cwd=cwd, extra_arguments=["--HistoryManager.enabled=False"])
+        kc.stop_channels()  # chaque exécution (nbclient) ouvre son propre client
+        _KERNEL = km
+        Finalize(None, km.shutdown_kernel, kwargs={"now": True}, exitpriority=10)
+        warm_up = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(_WARM_UP)])
+        execute(warm_up, km=_KERNEL, timeout=120, allow_errors=False)
+    reset = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(_RESET.format(cwd=cwd))])
+    execute(reset, km=_KERNEL, timeout=60, allow_errors=False)
+    return _KERNEL
+
+
 def _execute(path: str, timeout: int):
-    """Dans un processus de travail : lit et exécute le carnet ``path`` ; renvoie (chemin, carnet, durée,
-    erreur)."""
+    """Dans un processus de travail : lit et exécute le carnet ``path`` dans le noyau du processus ;
+    renvoie (chemin, carnet, durée, erreur)."""
     from jupyter_cache.executors.utils import single_nb_execution
     from myst_nb.core.read import myst_nb_reader_plugin
 
     notebook = myst_nb_reader_plugin(path)
-    result = single_nb_execution(notebook, cwd=str(Path(path).parent), timeout=timeout, allow_errors=False,
-                                 meta_override=True)
+    cwd = str(Path(path).parent)
+    result = single_nb_execution(notebook, cwd=cwd, timeout=timeout, allow_errors=False, meta_override=True,
+                                 km=_kernel(cwd))
     return path, notebook, result.time, result.exc_string if result.err is not None else None
 
 

@@ -18,7 +18,7 @@ if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
   rm -rf "$venv"
   log "environnement $venv ($python), requirements.txt…"
   "$python" -m venv "$venv"
-  if ! "$venv/bin/python" -m pip install -q --disable-pip-version-check -r requirements.txt >"$venv/pip-install.log" 2>&1; then
+  if ! "$venv/bin/python" -m pip install -q --no-compile --disable-pip-version-check -r requirements.txt >"$venv/pip-install.log" 2>&1; then
     log "ERREUR : pip install a échoué ; fin du journal ($venv/pip-install.log) :"
     grep -v "^WARNING: Location" "$venv/pip-install.log" | tail -n 30 >&2
     exit 1

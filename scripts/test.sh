@@ -5,7 +5,7 @@
 # en CI (CI=true), sinon par « bash scripts/setup.sh --pdf » (sans TeX Live, hors CI, ce test est sauté
 # avec un message).
 #
-# Sans argument, deux sessions pytest tournent en même temps, chacune sur un cœur au moins :
+# Sans argument, deux sessions pytest tournent en même temps (celle du paquet en priorité basse) :
 #   - le livre (marqueurs book, browser, pdf) : carnets exécutés en parallèle puis site construit, tests du
 #     site et du navigateur pendant que le PDF se construit, tests du PDF (voir tests/conftest.py) ;
 #   - le paquet : tous les autres tests.
@@ -27,7 +27,9 @@ book_log=$(mktemp)
 book_pid=$!
 trap 'kill "$book_pid" 2>/dev/null; true' INT TERM
 package=0
-.venv/bin/python -m pytest -m "not ($BOOK_MARKS)" || package=$?
+# La session du livre est le chemin critique (carnets, site, navigateur, PDF, l'un après l'autre) ; celle du
+# paquet, en priorité basse, prend le temps de calcul qu'elle laisse.
+nice -n 10 .venv/bin/python -m pytest -m "not ($BOOK_MARKS)" || package=$?
 book=0
 wait "$book_pid" || book=$?
 trap - INT TERM
