@@ -13,9 +13,6 @@ chapitre « Filtrer en parallèle dans le temps » : le livre se construit sans 
 from __future__ import annotations
 
 import argparse
-import datetime
-import os
-import platform
 import time
 from pathlib import Path
 
@@ -24,30 +21,11 @@ import numpy as np
 import kalman_course as kc
 from kalman_course.numbers import format_spec
 from kalman_course.scenarios.parallel import PARALLEL_P0, PARALLEL_X0, parallel_data, parallel_model
+from _timing import best_time, machine, software, write_measurement
 
 TARGET = 3.0
 LENGTHS = (1_000, 3_000, 10_000, 30_000, 100_000)
 OUTPUT = Path(__file__).resolve().parent.parent / "kalman_course" / "scenarios" / "parallel_timings.py"
-
-
-def best_time(func, repeat: int):
-    """Meilleur temps CPU du processus (s) de ``repeat`` appels, et le résultat du dernier."""
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        t0 = time.process_time()
-        out = func()
-        best = min(best, time.process_time() - t0)
-    return best, out
-
-
-def _machine() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return f"{cpu}, {os.cpu_count()} cœurs, {platform.system()} {platform.machine()}"
 
 
 def _gap(a, b, fields) -> float:
@@ -62,14 +40,14 @@ def main() -> None:
     args = parser.parse_args()
     model, x0, P0 = parallel_model(), PARALLEL_X0, PARALLEL_P0
     rows = []
-    print(f"Machine : {_machine()} ; Python {platform.python_version()}, numpy {np.__version__}")
+    print(f"Machine : {machine()} ; {software()}")
     for T in LENGTHS:
         y = parallel_data(T)
         repeat = args.repeat if T < 100_000 else max(1, args.repeat - 1)
-        t_seq, seq = best_time(lambda: kc.kalman_filter(model, y, x0, P0), repeat)
-        t_par, par = best_time(lambda: kc.parallel_kalman_filter(model, y, x0, P0), repeat)
-        t_seq_s, seq_s = best_time(lambda: kc.rts_smoother(model, kc.kalman_filter(model, y, x0, P0), x0, P0), repeat)
-        t_par_s, par_s = best_time(lambda: kc.parallel_rts_smoother(model, y, x0, P0), repeat)
+        t_seq, seq = best_time(lambda: kc.kalman_filter(model, y, x0, P0), repeat, time.process_time)
+        t_par, par = best_time(lambda: kc.parallel_kalman_filter(model, y, x0, P0), repeat, time.process_time)
+        t_seq_s, seq_s = best_time(lambda: kc.rts_smoother(model, kc.kalman_filter(model, y, x0, P0), x0, P0), repeat, time.process_time)
+        t_par_s, par_s = best_time(lambda: kc.parallel_rts_smoother(model, y, x0, P0), repeat, time.process_time)
         gap = _gap(par, seq, ("x", "P", "x_pred", "P_pred", "K", "innovation", "S"))
         gap_s = _gap(par_s, seq_s, ("x", "P", "G"))
         ratio, ratio_s = t_seq / t_par, t_seq_s / t_par_s
@@ -81,19 +59,13 @@ def main() -> None:
         rows.append((T, t_seq, t_par, t_seq_s, t_par_s))
     if args.write:
         T, seq, par, seq_s, par_s = (list(c) for c in zip(*rows))
-        OUTPUT.write_text(
-            '"""Temps CPU mesurés par benchmarks/parallel.py --write (secondes, meilleur de plusieurs essais) : la\n'
-            'figure du chapitre « Filtrer en parallèle dans le temps » les lit ; le livre ne chronomètre rien."""\n\n'
-            f"DATE = {datetime.date.today().isoformat()!r}\n"
-            f"MACHINE = {_machine()!r}\n"
-            f"SOFTWARE = {f'Python {platform.python_version()}, numpy {np.__version__}'!r}\n"
-            f"T = {tuple(T)!r}\n"
-            f"SEQUENTIAL = {tuple(round(t, 5) for t in seq)!r}\n"
-            f"PARALLEL = {tuple(round(t, 5) for t in par)!r}\n"
-            f"SEQUENTIAL_SMOOTHER = {tuple(round(t, 5) for t in seq_s)!r}\n"
-            f"PARALLEL_SMOOTHER = {tuple(round(t, 5) for t in par_s)!r}\n"
-        )
-        print(f"Mesure écrite dans {OUTPUT}")
+        write_measurement(OUTPUT, "Temps CPU mesurés par benchmarks/parallel.py --write (secondes, meilleur de plusieurs "
+                          "essais) : la\nfigure du chapitre « Filtrer en parallèle dans le temps » les lit ; le livre ne "
+                          "chronomètre rien.",
+                          {"T": tuple(T), "SEQUENTIAL": tuple(round(t, 5) for t in seq),
+                           "PARALLEL": tuple(round(t, 5) for t in par),
+                           "SEQUENTIAL_SMOOTHER": tuple(round(t, 5) for t in seq_s),
+                           "PARALLEL_SMOOTHER": tuple(round(t, 5) for t in par_s)})
 
 
 if __name__ == "__main__":

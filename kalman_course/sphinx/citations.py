@@ -122,19 +122,24 @@ def _formatting_style():
         def format_chapter_and_pages(self, e):
             return join(sep=", ")[optional[together["chapitre", field("chapter")]], optional[together["pages", pages]]]
 
+        def format_in_book(self, e, where):
+            # « Dans Éd., éd., Titre du recueil, volume …, » puis ``where`` (chapitre, pages) : chapitre d'un
+            # ouvrage collectif et communication dans des actes
+            return words[
+                "Dans",
+                sentence[
+                    optional[self.format_editor(e, as_sentence=False)],
+                    self.format_btitle(e, "booktitle", as_sentence=False),
+                    self.format_volume_and_series(e, as_sentence=False),
+                    where,
+                ],
+            ]
+
         def get_incollection_template(self, e):
             return toplevel[
                 sentence[self.format_names("author")],
                 self.format_title(e, "title"),
-                words[
-                    "Dans",
-                    sentence[
-                        optional[self.format_editor(e, as_sentence=False)],
-                        self.format_btitle(e, "booktitle", as_sentence=False),
-                        self.format_volume_and_series(e, as_sentence=False),
-                        self.format_chapter_and_pages(e),
-                    ],
-                ],
+                self.format_in_book(e, self.format_chapter_and_pages(e)),
                 sentence[optional_field("publisher"), optional_field("address"), self.format_edition(e), date],
                 sentence[optional_field("note")],
                 self.format_web_refs(e),
@@ -158,16 +163,7 @@ def _formatting_style():
             return toplevel[
                 sentence[self.format_names("author")],
                 self.format_title(e, "title"),
-                words[
-                    "Dans",
-                    sentence[
-                        optional[self.format_editor(e, as_sentence=False)],
-                        self.format_btitle(e, "booktitle", as_sentence=False),
-                        self.format_volume_and_series(e, as_sentence=False),
-                        optional[pages],
-                    ],
-                    self.format_address_organization_publisher_date(e),
-                ],
+                words[self.format_in_book(e, optional[pages]), self.format_address_organization_publisher_date(e)],
                 sentence[optional_field("note")],
                 self.format_web_refs(e),
             ]
