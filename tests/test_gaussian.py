@@ -134,14 +134,18 @@ def test_unscented_sums_keep_their_digits_far_from_zero_with_a_small_alpha():
 # --------------------------------------------------------------------------- CKF
 
 
-@pytest.mark.parametrize("case", ["pendule", "tag"])
-def test_cubature_with_redraw_equals_the_ukf_alpha_one_beta_zero_kappa_zero(case):
-    if case == "pendule":
-        model, data = pendulum.pendulum_model(), pendulum.pendulum_data(200)
-    else:
-        model, data = _tag_model_and_data()
+@pytest.fixture(params=["pendule", "tag"])
+def cubature_case(request):
+    """Le pendule ou le tag, avec deux mesures manquantes : (modèle, y, données)."""
+    model, data = (pendulum.pendulum_model(), pendulum.pendulum_data(200)) if request.param == "pendule" \
+        else _tag_model_and_data()
     y = np.array(data.y)
     y[[3, 17]] = np.nan
+    return model, y, data
+
+
+def test_cubature_with_redraw_equals_the_ukf_alpha_one_beta_zero_kappa_zero(cubature_case):
+    model, y, data = cubature_case
     ckf = kc.cubature_kalman_filter(model, y, data.x0, data.P0)
     ukf = kc.unscented_kalman_filter(model, y, data.x0, data.P0, alpha=1.0, beta=0.0, kappa=0.0)
     _same(ckf, ukf, rtol=0, atol=1e-10)
@@ -149,14 +153,8 @@ def test_cubature_with_redraw_equals_the_ukf_alpha_one_beta_zero_kappa_zero(case
     _same(runs.run(1), ckf, rtol=0, atol=1e-10)
 
 
-@pytest.mark.parametrize("case", ["pendule", "tag"])
-def test_cubature_without_redraw_equals_filterpy_cubature_kalman_filter(case):
-    if case == "pendule":
-        model, data = pendulum.pendulum_model(), pendulum.pendulum_data(200)
-    else:
-        model, data = _tag_model_and_data()
-    y = np.array(data.y)
-    y[[3, 17]] = np.nan
+def test_cubature_without_redraw_equals_filterpy_cubature_kalman_filter(cubature_case):
+    model, y, data = cubature_case
     ours = kc.cubature_kalman_filter(model, y, data.x0, data.P0, redraw=False)
     ref = filterpy_cubature_filter(model, y, data.x0, data.P0)
     _same(ours, ref, rtol=1e-9, atol=1e-9)
