@@ -583,17 +583,16 @@ def _check_quiz(site: Site, html_file: Path, visit: Visit, problems: list[str], 
         question = questions.nth(q)
         answer = int(question.get_attribute("data-answer"))
         radios = question.locator("input[type=radio]")
-        wrong = 1 if answer != 1 else 2
-        radios.nth(wrong - 1).check()
-        question.locator(".kc-quiz-check").click()
-        classes = question.get_attribute("class").split()
-        feedback = question.locator(".kc-quiz-feedback").text_content()
+
+        def submit(choice: int) -> tuple[list[str], str]:  # coche la réponse n° choice et vérifie
+            radios.nth(choice - 1).check()
+            question.locator(".kc-quiz-check").click()
+            return question.get_attribute("class").split(), question.locator(".kc-quiz-feedback").text_content()
+
+        classes, feedback = submit(1 if answer != 1 else 2)
         if "kc-quiz-wrong" not in classes or not feedback.startswith("Pas tout"):
             problems.append(f"{name} : question {q + 1}, une mauvaise réponse n'est pas marquée fausse")
-        radios.nth(answer - 1).check()
-        question.locator(".kc-quiz-check").click()
-        classes = question.get_attribute("class").split()
-        feedback = question.locator(".kc-quiz-feedback").text_content()
+        classes, feedback = submit(answer)
         if "kc-quiz-right" not in classes or not feedback.startswith("Juste"):
             problems.append(f"{name} : question {q + 1}, la bonne réponse n'est pas marquée juste")
         explanation = question.locator(".kc-quiz-explanation")
