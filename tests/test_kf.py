@@ -199,6 +199,29 @@ def test_step_functions_compose_to_runner():
         np.testing.assert_allclose(res.innovation[k], upd.innovation, atol=1e-13)
 
 
+def test_square_root_covariances_formed_at_the_end_equal_the_textbook_ones():
+    """La forme racine carrée range les racines de P, P⁻ et S et ne forme les covariances qu'à la fin (un
+    produit en lot) : mêmes valeurs que la forme du cours, exactement symétriques, aux pas sans mesure
+    (deux de suite : racine rectangulaire), partiels, rejetés par la porte ou à mémoire évanescente ; S
+    NaN aux mêmes endroits."""
+    rng = np.random.default_rng(8)
+    model = random_model(rng, 3, 2, 0)
+    y = kc.simulate(model, np.ones(3), 60, rng=rng).y.copy()
+    y[[3, 4, 30]] = np.nan  # pas sans mesure
+    y[[10, 41], 0] = np.nan  # pas partiels
+    y[[20, 50], 1] += 50.0  # aberrations, que la porte rejette
+    for options in ({}, {"gate": 0.99}, {"gate": 0.99, "fading": 1.05}):
+        ours = kc.kalman_filter(model, y, np.zeros(3), np.eye(3), **options)
+        ref = kc.kalman_filter(model, y, np.zeros(3), np.eye(3), form="textbook", **options)
+        np.testing.assert_array_equal(ours.n_iter, ref.n_iter)
+        assert ours.rejected[[20, 50]].all() == bool(options)
+        for name in ("P", "P_pred", "S"):
+            ours_cov, ref_cov = getattr(ours, name), getattr(ref, name)
+            np.testing.assert_array_equal(np.isnan(ours_cov), np.isnan(ref_cov))
+            np.testing.assert_allclose(ours_cov, ref_cov, **TOL)
+            np.testing.assert_array_equal(ours_cov, np.swapaxes(ours_cov, 1, 2))
+
+
 # --------------------------------------------------------------------------- invariants
 
 

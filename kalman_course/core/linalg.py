@@ -25,10 +25,12 @@ from .validation import KalmanInputError
 
 __all__ = [
     "symmetrize", "psd_solve", "is_positive_definite", "kalman_gain", "correct", "correct_many", "cholesky_factor",
-    "covariance_factor", "covariance_root", "triangular_root", "correct_square_root", "centred_rows", "weighted_rows",
+    "covariance_factor", "covariance_root", "gram", "triangular_root", "square_root_blocks", "correct_square_root",
+    "centred_rows", "weighted_rows",
 ]
 
-_posv, _geqrf, _trtri = scipy.linalg.get_lapack_funcs(("posv", "geqrf", "trtri"), dtype=np.float64)
+_posv, _geqrf = scipy.linalg.get_lapack_funcs(("posv", "geqrf"), dtype=np.float64)
+_trsm = scipy.linalg.get_blas_funcs("trsm", dtype=np.float64)
 
 #: Message par défaut quand :math:`S` n'est pas définie positive.
 S_NOT_PD = (
@@ -167,10 +169,19 @@ SINGULAR_ROOT_RTOL = 1e-12
 
 
 @lru_cache(maxsize=64)
-def _upper_mask(n: int) -> np.ndarray:
-    mask = np.triu(np.ones((n, n)))
+def _upper_mask(shape: tuple[int, int]) -> np.ndarray:
+    """Masque ``shape`` des éléments sur et au-dessus de la diagonale, rangé en ordre Fortran comme la sortie
+    de LAPACK : ``qr *= _upper_mask(qr.shape)`` parcourt alors deux tableaux contigus (sur une vue, numpy
+    paierait deux à trois fois plus cher)."""
+    mask = np.asfortranarray(np.triu(np.ones(shape)))
     mask.setflags(write=False)
     return mask
+
+
+def gram(M: np.ndarray) -> np.ndarray:
+    r""":math:`M^TM` (…, n, n) d'une racine ``M`` (…, r, n) : la covariance qu'elle porte, exactement
+    symétrique (un seul produit, en lot pour une pile de racines ; des lignes nulles n'y changent rien)."""
+    return M.T.dot(M) if M.ndim == 2 else np.matmul(np.swapaxes(M, -1, -2), M)
 
 
 def triangular_root(M: np.ndarray) -> np.ndarray:
@@ -188,8 +199,9 @@ def triangular_root(M: np.ndarray) -> np.ndarray:
         return np.linalg.qr(M, mode="r")
     if r < n:
         M = np.vstack([M, np.zeros((n - r, n))])
-    qr = _geqrf(M)[0]  # R au-dessus de la diagonale, réflecteurs de Householder au-dessous
-    return qr[:n] * _upper_mask(n)
+    qr = _geqrf(M)[0]  # R au-dessus de la diagonale, réflecteurs de Householder au-dessous…
+    qr *= _upper_mask(qr.shape)  # … effacés
+    return qr[:n]
 
 
 def covariance_root(P: np.ndarray) -> np.ndarray:
@@ -205,8 +217,29 @@ def covariance_root(P: np.ndarray) -> np.ndarray:
         return triangular_root(covariance_factor(P).T)
 
 
+def square_root_blocks(H: np.ndarray, U_R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    r"""Les deux blocs constants du pré-tableau de :func:`correct_square_root`, qui ne dépendent que de
+    :math:`H` (m, n) et :math:`U_R` (m, m) :
+
+    .. math::
+
+        \begin{bmatrix} U_R & 0 \end{bmatrix}\ (m \times (m + n)),\qquad
+        \begin{bmatrix} H^T & I_n \end{bmatrix}\ (n \times (m + n)),
+
+    le second donnant toutes les autres lignes en un seul produit : :math:`[MH^T\ \ M] = M\,[H^T\ \ I_n]`
+    (multiplier par :math:`I_n` est exact). Un modèle constant les calcule une fois
+    (:attr:`~kalman_course.LinearGaussianModel.square_root_blocks`)."""
+    m, n = H.shape
+    top = np.zeros((m, m + n))
+    top[:, :m] = U_R
+    HtI = np.empty((n, m + n))
+    HtI[:, :m] = H.T
+    HtI[:, m:] = np.eye(n)
+    return top, HtI
+
+
 def correct_square_root(x_pred: np.ndarray, M_pred: np.ndarray, nu: np.ndarray, H: np.ndarray,
-                        U_R: np.ndarray, where: str = ""):
+                        U_R: np.ndarray, where: str = "", blocks: tuple[np.ndarray, np.ndarray] | None = None):
     r"""Correction linéaire en racine carrée : la forme « tableau » de Morf et Kailath (1975).
 
     Avec une racine :math:`M` de :math:`P^-` (:math:`M^TM = P^-`, ``r`` ≥ n lignes : triangulaire, ou
@@ -221,17 +254,18 @@ def correct_square_root(x_pred: np.ndarray, M_pred: np.ndarray, nu: np.ndarray, 
         U_S^TU_S = S = HP^-H^T + R,\quad (U^+)^TU^+ = P^- - P^-H^TS^{-1}HP^-,
 
     et :math:`\bar K^T = U_S^{-T}HP^-`, d'où :math:`K^T = U_S^{-1}\bar K^T` (:math:`U_S` triangulaire,
-    :math:`m \times m`) et :math:`x = x^- + K\nu`. La covariance a posteriori n'est jamais calculée
-    par la soustraction :math:`P^- - KHP^-` : elle reste semi-définie positive et garde ses petites
-    valeurs propres même quand :math:`P^-` est énorme (a priori vague, :math:`P_0 = 10^{14}I`). Si un
-    élément diagonal de :math:`U_S` ne dépasse pas :data:`SINGULAR_ROOT_RTOL` fois le plus grand,
-    :math:`S` est singulière à la précision de la double (la QR n'en garde plus la petite racine) :
-    :class:`KalmanInputError`, comme la forme du cours.
+    :math:`m \times m`, une résolution triangulaire) et :math:`x = x^- + K\nu`. La covariance a
+    posteriori n'est jamais calculée par la soustraction :math:`P^- - KHP^-` : elle reste semi-définie
+    positive et garde ses petites valeurs propres même quand :math:`P^-` est énorme (a priori vague,
+    :math:`P_0 = 10^{14}I`). Si un élément diagonal de :math:`U_S` ne dépasse pas
+    :data:`SINGULAR_ROOT_RTOL` fois le plus grand, :math:`S` est singulière à la précision de la double
+    (la QR n'en garde plus la petite racine) : :class:`KalmanInputError`, comme la forme du cours.
 
-    ``x_pred`` (n,), ``M_pred`` (r, n), ``nu`` (m,), ``H`` (m, n), ``U_R`` (m, m) ; ou, pour ``N``
-    tirages, ``x_pred`` (N, n), ``nu`` (N, m) et ``M_pred`` (r, n) commune (covariances communes) ou
-    (N, r, n). Renvoie ``(x, U, K, U_S)`` : ``U`` (…, n, n) racine triangulaire de :math:`P`, ``K``
-    (…, n, m), ``U_S`` (…, m, m) racine de :math:`S`."""
+    ``x_pred`` (n,), ``M_pred`` (r, n), ``nu`` (m,), ``H`` (m, n), ``U_R`` (m, m) ; ``blocks`` : les
+    blocs constants :math:`([U_R\ \ 0], [H^T\ \ I_n])` de :func:`square_root_blocks`, s'ils sont déjà
+    calculés. Ou, pour ``N`` tirages, ``x_pred`` (N, n), ``nu`` (N, m) et ``M_pred`` (r, n) commune
+    (covariances communes) ou (N, r, n). Renvoie ``(x, U, K, U_S)`` : ``U`` (…, n, n) racine triangulaire
+    de :math:`P`, ``K`` (…, n, m), ``U_S`` (…, m, m) racine de :math:`S`."""
     m, n = H.shape
     r = M_pred.shape[-2]
     if M_pred.ndim > 2:  # une racine par tirage : QR en pile
@@ -245,19 +279,19 @@ def correct_square_root(x_pred: np.ndarray, M_pred: np.ndarray, nu: np.ndarray, 
         Kt = np.linalg.solve(U_S, post[..., :m, m:])
         K = np.swapaxes(Kt, -1, -2)
         return x_pred + (K @ nu[..., None])[..., 0], post[..., m:, m:], K, U_S
-    pre = np.zeros((m + r, m + n))
-    pre[:m, :m] = U_R
-    pre[m:, :m] = M_pred.dot(H.T)
-    pre[m:, m:] = M_pred
-    post = _geqrf(pre)[0][:m + n]
-    post *= _upper_mask(m + n)
+    top, HtI = square_root_blocks(H, U_R) if blocks is None else blocks
+    pre = np.empty((m + r, m + n))
+    pre[:m] = top                          # [U_R, 0]
+    np.dot(M_pred, HtI, out=pre[m:])       # [M Hᵀ, M] = M [Hᵀ, I]
+    post = _geqrf(pre)[0]                  # R au-dessus de la diagonale, réflecteurs au-dessous…
+    post *= _upper_mask(post.shape)        # … effacés : U_S et U⁺ triangulaires
     U_S = post[:m, :m]
     if m > 1:  # en flottants Python : une réduction numpy coûte plus cher que toute la correction
         d = [abs(U_S.item(i, i)) for i in range(m)]
         if min(d) <= SINGULAR_ROOT_RTOL * max(d):
             _check_root(np.array([d]), where)
-    Kt = _trtri(U_S)[0].dot(post[:m, m:])  # U_S⁻¹ K̄ᵀ (U_S triangulaire, m × m)
-    return x_pred + nu.dot(Kt), post[m:, m:], Kt.T, U_S  # nu (N, m) : une ligne par tirage
+    Kt = _trsm(1.0, U_S, post[:m, m:])     # U_S Kᵀ = K̄ᵀ (résolution triangulaire, BLAS trsm)
+    return x_pred + nu.dot(Kt), post[m:m + n, m:], Kt.T, U_S  # nu (N, m) : une ligne par tirage
 
 
 def _check_root(d: np.ndarray, where: str, stacked: bool = False) -> None:

@@ -23,7 +23,7 @@ import numpy as np
 
 from .angles import wrap_angle
 from .jacobians import numerical_jacobian
-from .linalg import is_positive_definite, covariance_root
+from .linalg import covariance_root, is_positive_definite, square_root_blocks
 from .validation import (
     KalmanInputError,
     as_float_array,
@@ -199,6 +199,14 @@ class LinearGaussianModel:
         :math:`U_R^TU_R = R` (m, m) (:func:`~kalman_course.core.linalg.covariance_root`), calculées une fois
         pour le filtre de Kalman en racine carrée."""
         return _readonly(covariance_root(self.Q)), _readonly(covariance_root(self.R))
+
+    @cached_property
+    def square_root_blocks(self) -> tuple[np.ndarray, np.ndarray]:
+        r"""Blocs constants du pré-tableau de la correction en racine carrée d'un modèle constant,
+        :math:`[U_R\ \ 0]` (m, m + n) et :math:`[C^T\ \ I_n]` (n, m + n)
+        (:func:`~kalman_course.core.linalg.square_root_blocks`), calculés une fois : à chaque pas, les
+        lignes :math:`[MC^T\ \ M]` du pré-tableau ne coûtent qu'un produit, :math:`M\,[C^T\ \ I_n]`."""
+        return tuple(_readonly(a) for a in square_root_blocks(self.C, self.noise_roots[1]))
 
     def __repr__(self) -> str:
         extra = "" if self._n_steps is None else f", variable sur {self._n_steps} pas"

@@ -6,6 +6,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from .linalg import gram
 from .validation import KalmanInputError
 
 __all__ = ["FilterResult", "FilterRuns", "FilterHistory", "freeze", "freeze_fields"]
@@ -151,16 +152,29 @@ class FilterHistory:
     ``state_shape`` : forme d'une estimation (``(n,)``, ou ``(4, 4)`` pour une pose) ; ``d`` : dimension
     de la covariance ; ``m`` : dimension de la mesure. :meth:`correction` range le gain, l'innovation et
     sa covariance aux composantes observées (gain nul, innovation et ``S`` NaN ailleurs).
+
+    ``root_rows`` : le filtre porte des **racines** au lieu des covariances (:math:`M^TM = P`, au plus
+    ``root_rows`` lignes) ; ``P`` et ``P_pred`` rangent alors des racines (T, root_rows, d), complétées de
+    lignes nulles (qui ne changent pas :math:`M^TM`), ``S`` des racines (T, m, m) de :math:`S` (zéros hors
+    des composantes observées), et :meth:`result` forme toutes les covariances à la fin, en un produit
+    en lot (:func:`~kalman_course.core.linalg.gram`).
     """
 
-    def __init__(self, T: int, state_shape: tuple[int, ...], d: int, m: int, observed: np.ndarray) -> None:
+    def __init__(self, T: int, state_shape: tuple[int, ...], d: int, m: int, observed: np.ndarray,
+                 root_rows: int | None = None) -> None:
         self.x = np.empty((T, *state_shape))
-        self.P = np.empty((T, d, d))
         self.x_pred = np.empty((T, *state_shape))
-        self.P_pred = np.empty((T, d, d))
+        self.root_rows = root_rows
+        if root_rows is None:
+            self.P = np.empty((T, d, d))
+            self.P_pred = np.empty((T, d, d))
+            self.S = np.full((T, m, m), np.nan)
+        else:
+            self.P = np.zeros((T, root_rows, d))
+            self.P_pred = np.zeros((T, root_rows, d))
+            self.S = np.zeros((T, m, m))
         self.K = np.zeros((T, d, m))  # gain nul pour une composante manquante : aucune correction
         self.innovation = np.full((T, m), np.nan)
-        self.S = np.full((T, m, m), np.nan)
         self.observed = observed
         self.n_iter = np.zeros(T, dtype=int)
 
@@ -187,7 +201,11 @@ class FilterHistory:
     def result(self, result_type: type | None = None, **extra) -> "FilterResult":
         """Le résultat figé ; ``extra`` : champs propres à ``result_type`` (sorties empilées de chaque pas)."""
         cls = FilterResult if result_type is None else result_type
+        P, P_pred, S = self.P, self.P_pred, self.S
+        if self.root_rows is not None:  # des racines : les covariances, toutes à la fois
+            P, P_pred, S = gram(P), gram(P_pred), gram(S)
+            S[~(self.observed[:, :, None] & self.observed[:, None, :])] = np.nan
         return cls(
-            x=self.x, P=self.P, x_pred=self.x_pred, P_pred=self.P_pred, K=self.K,
-            innovation=self.innovation, S=self.S, observed=self.observed, n_iter=self.n_iter, **extra,
+            x=self.x, P=P, x_pred=self.x_pred, P_pred=P_pred, K=self.K,
+            innovation=self.innovation, S=S, observed=self.observed, n_iter=self.n_iter, **extra,
         )

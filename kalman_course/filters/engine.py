@@ -21,6 +21,12 @@ Deux crochets facultatifs servent les filtres de Monte-Carlo (filtre particulair
   l'échantillon, incrément de log-vraisemblance, particules…) ; le moteur les empile, temps en premier,
   et les passe au constructeur de ``result_type`` sous ces noms.
 
+Un troisième crochet sert les filtres en racine carrée : ``root_rows(model)`` → nombre maximal de lignes
+d'une racine. L'état interne porte alors, en ``state[1]``, une racine :math:`M` de la covariance
+(:math:`M^TM = P`) et ``Correction.S`` une racine de :math:`S` ; le moteur range ces racines à chaque pas
+et forme toutes les covariances du résultat à la fin, en un produit en lot, au lieu d'un produit
+:math:`M^TM` par pas qui ne servirait qu'au résultat.
+
 Le moteur (:func:`run_filter`) fait, une fois pour toutes les familles, ce que faisait chaque boucle :
 vérifier le modèle, ``y``, ``u``, l'a priori ; traiter les mesures manquantes (ligne ``None``/``NaN`` :
 prédiction seule ; ligne partielle : correction avec les seules composantes observées) ; assembler le
@@ -100,6 +106,11 @@ class FilterFamily:
     ``stochastic`` : les étapes tirent au hasard et reçoivent ``rng=`` (un ``numpy.random.Generator``) ;
     ``step_outputs(state)`` : sorties supplémentaires de chaque pas (dictionnaire de tableaux), empilées
     dans le temps et passées à ``result_type``.
+    ``root_rows(model)`` : l'état porte une racine de la covariance au lieu de la covariance —
+    ``state[1]`` est une racine :math:`M` (r × d, r ≤ ``root_rows(model)``), :math:`M^TM = P`, et
+    ``Correction.S`` une racine (m_k × m_k) de :math:`S` ; :func:`run_filter` ne lit pas ``moments`` mais
+    ``state[0]`` et la racine ``state[1]``, et forme les covariances à la fin
+    (:class:`~kalman_course.core.results.FilterHistory`).
 
     Mode en lot (facultatif, pour :func:`run_filter_runs`) : ``prior_many(model, x0, P0, N)`` → état
     interne des ``N`` tirages, un **tuple de tableaux dont le premier axe est celui des tirages** ;
@@ -130,6 +141,7 @@ class FilterFamily:
     tangent_dim: Callable[[Any], int] = field(default=lambda model: model.n_state)
     stochastic: bool = False
     step_outputs: Callable[[Any], dict[str, Any]] | None = None
+    root_rows: Callable[[Any], int] | None = None
     prior_many: Callable[[Any, Any, Any, int], Any] | None = None
     predict_many: Callable[[Any, Any, np.ndarray | None, int], Any] | None = None
     update_many: Callable[[Any, Any, np.ndarray, np.ndarray | None, int], tuple[Any, Correction]] | None = None
@@ -218,7 +230,9 @@ def run_filter(
         prior, predict, update = (partial(f, **draws) for f in (prior, predict, update))
     state = prior(model, x0, P0)
     observed = observed_rows(Y)
-    out = FilterHistory(T, family.state_shape(model), family.tangent_dim(model), m, observed)
+    roots = family.root_rows is not None  # l'état porte une racine de la covariance (famille en racine carrée)
+    out = FilterHistory(T, family.state_shape(model), family.tangent_dim(model), m, observed,
+                        family.root_rows(model) if roots else None)
     full = observed.all(axis=1).tolist()  # booléens Python : la boucle n'indexe pas de tableau numpy à chaque pas
     some = observed.any(axis=1).tolist()
     extras: dict[str, list] = {}
@@ -240,7 +254,11 @@ def run_filter(
             out.correction(k, corr, idx)
         else:
             state = predicted
-        if moments is None:
+        if roots:  # racines complétées de lignes nulles ; covariances formées à la fin
+            M_pred, M = predicted[1], state[1]
+            xps[k], Pps[k, :len(M_pred)] = predicted[0], M_pred
+            xs[k], Ps[k, :len(M)] = state[0], M
+        elif moments is None:
             xps[k], Pps[k] = predicted[0], predicted[1]
             xs[k], Ps[k] = state[0], state[1]
         else:

@@ -7,18 +7,19 @@ Notations (cours → paquet) : :math:`A, B, C` identiques, :math:`\Phi \to Q`, :
 **Trois formes de la covariance a posteriori** (option ``form``, mêmes valeurs en arithmétique exacte) :
 
 * ``"square_root"`` (par défaut) : le filtre propage une racine triangulaire :math:`U` de :math:`P`
-  (:math:`U^TU = P`) ; prédiction et correction sont chacune une QR d'un pré-tableau
-  (:func:`~kalman_course.core.linalg.triangular_root`,
-  :func:`~kalman_course.core.linalg.correct_square_root`). Aucune soustraction de covariances : :math:`P`
+  (:math:`U^TU = P`) ; la prédiction empile les racines :math:`[UA^T; U_Q]` de :math:`P^-`, la correction
+  triangularise par une seule QR le pré-tableau qui les contient
+  (:func:`~kalman_course.core.linalg.correct_square_root`). Aucune soustraction de covariances : :math:`P`
   reste semi-définie positive et garde ses petites valeurs propres quand :math:`P_0` est vague. Mesuré
   (``tests/test_family.py``) : avec :math:`P_0 = 10^{10}I` puis :math:`10^{14}I`, l'écart au départ
   diffus exact reste de l'ordre de :math:`10^{-11}` à :math:`10^{-8}`, quand la forme de Joseph (celle
   de filterpy) s'écarte de :math:`10^{-5}` à :math:`10^{-3}` et que la forme du cours échoue
   (:math:`S` n'est plus définie positive). C'est pourquoi elle est la forme par défaut : la justesse
-  d'abord. Son prix (temps CPU, ``benchmarks/kf_vs_filterpy.py``) : une QR et une inverse triangulaire
-  par pas, de 0,8 × (un état) à 1,0 × (quatre états) le temps par pas de filterpy, contre 0,5 à 0,7 × pour
-  la forme du cours ; en lot (``kalman_filter_runs``), la Riccati commune est calculée une fois et le coût
-  par tirage ne dépend plus de la forme.
+  d'abord. Son prix : une QR et une résolution triangulaire par pas (les covariances :math:`P, P^-, S`
+  du résultat ne sont formées qu'à la fin, en un produit en lot sur les racines rangées) ; en temps CPU
+  (``benchmarks/kf_vs_filterpy.py``), de 0,6 × (un état) à 0,7 × (quatre états) le temps par pas de
+  filterpy, contre 0,5 à 0,7 × pour la forme du cours ; en lot (``kalman_filter_runs``), la Riccati
+  commune est calculée une fois et le coût par tirage ne dépend plus de la forme.
 * ``"textbook"`` : la formule du cours :math:`P = (I - KC)P^-`, calculée :math:`P^- - K(P^-C^T)^T` ; la
   moins coûteuse, exacte pour le gain optimal, mais elle soustrait deux nombres de l'ordre de :math:`P^-`
   et perd tous ses chiffres quand :math:`P^-` est très grande devant :math:`R` (chapitre SRIF).
@@ -37,7 +38,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.linalg import (
-    correct, correct_many, correct_square_root, covariance_root, kalman_gain, symmetrize, triangular_root,
+    correct, correct_many, correct_square_root, covariance_root, gram, kalman_gain, symmetrize, triangular_root,
 )
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult, FilterRuns
@@ -155,8 +156,9 @@ def update(model: LinearGaussianModel, x_pred: Any, P_pred: Any, y: Any, *, form
     y_arr = as_vector("y", y, model.n_obs)
     nu = y_arr - model.C @ x_arr
     if form == "square_root":
-        x, U, K, U_S = correct_square_root(x_arr, covariance_root(P_arr), nu, model.C, model.noise_roots[1])
-        return Update(x, U.T.dot(U), K, nu, U_S.T.dot(U_S))
+        x, U, K, U_S = correct_square_root(x_arr, covariance_root(P_arr), nu, model.C, model.noise_roots[1],
+                                           blocks=model.square_root_blocks)
+        return Update(x, gram(U), K, nu, gram(U_S))
     x, P, K, S = correct(x_arr, P_arr, nu, model.C, model.R, form == "joseph")
     return Update(x, P, K, nu, S)
 
@@ -279,11 +281,6 @@ def kalman_filter_runs(
     return run_filter_runs(kalman_family(form), model, Y, x0, P0, u)
 
 
-def _gram(M: np.ndarray) -> np.ndarray:
-    r""":math:`M^TM` (…, n, n) d'une racine ``M`` (…, r, n) : la covariance qu'elle porte (exactement symétrique)."""
-    return M.T.dot(M) if M.ndim == 2 else np.swapaxes(M, -1, -2) @ M
-
-
 def _predicted_root(U: np.ndarray, A: np.ndarray, U_Q: np.ndarray) -> np.ndarray:
     r"""Racine de :math:`P^- = AP A^T + Q` à partir d'une racine ``U`` (…, r, n) de :math:`P` : les racines
     empilées :math:`[UA^T; U_Q]` ((r + n) × n), que la QR de la correction triangularisera (une QR par pas au
@@ -312,9 +309,11 @@ def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None)
     (:func:`~kalman_course.filters.engine.run_filter`) ou ``N`` à la fois
     (:func:`~kalman_course.filters.engine.run_filter_runs`).
 
-    État interne :math:`(\hat x, P, M)` pour ``form="square_root"`` — la racine :math:`M` (:math:`M^TM = P`)
-    porte le calcul, :math:`P` est lue sur elle à chaque pas pour le résultat — et :math:`(\hat x, P)` pour
-    les deux autres formes. Étapes en lot : la moyenne a une ligne par tirage (N, n), la covariance et sa
+    État interne d'un tirage : :math:`(\hat x, M)` pour ``form="square_root"`` — la racine :math:`M`
+    (:math:`M^TM = P`) porte tout le calcul, et la famille le déclare au moteur (``root_rows``) : il range
+    les racines et forme les covariances :math:`P, P^-, S` du résultat à la fin, en un produit en lot — et
+    :math:`(\hat x, P)` pour les deux autres formes. Étapes en lot : :math:`(\hat X, P, M)` en racine
+    carrée, :math:`(\hat X, P)` sinon ; la moyenne a une ligne par tirage (N, n), la covariance et sa
     racine sont communes à tous les tirages (n, n) (Riccati commune) ou une par tirage (N, n, n) ; la
     commande est (p,) ou (N, p).
 
@@ -335,38 +334,42 @@ def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None)
     if square_root:
         def prior(model, x0, P0):
             x, P = gaussian_prior(model, x0, P0)
-            return x, P, covariance_root(P)
+            return x, covariance_root(P)
 
         def prior_many(model, x0, P0, N, shared=False):
             X, P = gaussian_prior_many(model, x0, P0, N, shared=shared)
             return X, P, covariance_root(P)
 
-        def predict(model, state, u):  # un tirage
-            x, _, U = state
+        def predict(model, state, u):  # un tirage : x̂⁻ = A x̂ + B u, racine M = [U Aᵀ; U_Q] de P⁻ (2n × n)
+            x, U = state
             A = model.A
             if U.shape[0] > A.shape[0]:  # le pas précédent était sans mesure : racine rectangulaire
                 U = triangular_root(U)
             M = np.concatenate((U.dot(A.T), model.noise_roots[0]))
-            return (A.dot(x) if u is None else A.dot(x) + model.B.dot(u)), M.T.dot(M), M
+            return (A.dot(x) if u is None else A.dot(x) + model.B.dot(u)), M
 
-        def update(model, state, y, idx):
-            x_pred, _, M = state
-            C, U_R = _observed_part(model, idx, True)
+        def update(model, state, y, idx):  # une QR ; rend la racine U de P et celle de S (Correction.S)
+            x_pred, M = state
+            if idx is None:  # toutes les composantes : blocs constants du pré-tableau, calculés une fois
+                C, U_R, blocks = model.C, model.noise_roots[1], model.square_root_blocks
+            else:
+                (C, U_R), blocks = _observed_part(model, idx, True), None
             nu = y - C.dot(x_pred)
-            x, U, K, U_S = correct_square_root(x_pred, M, nu, C, U_R)
-            return (x, U.T.dot(U), U), Correction(K, nu, U_S.T.dot(U_S))
+            x, U, K, U_S = correct_square_root(x_pred, M, nu, C, U_R, blocks=blocks)
+            return (x, U), Correction(K, nu, U_S)
 
         def predict_many(model, state, u, k):
             X, _, U = state
             M = _predicted_root(U, model.A, model.noise_roots[0])
-            return predict_mean(model, X, u), _gram(M), M
+            return predict_mean(model, X, u), gram(M), M
 
         def update_many(model, state, Y, idx, k):
             X_pred, _, M = state
             C, U_R = _observed_part(model, idx, True)
             nu = Y - X_pred.dot(C.T)
-            X, U, K, U_S = correct_square_root(X_pred, M, nu, C, U_R, f"correction par y[{k}]")
-            return (X, _gram(U), U), Correction(K, nu, _gram(U_S))
+            blocks = model.square_root_blocks if idx is None else None
+            X, U, K, U_S = correct_square_root(X_pred, M, nu, C, U_R, f"correction par y[{k}]", blocks)
+            return (X, gram(U), U), Correction(K, nu, gram(U_S))
     else:
         prior = gaussian_prior
 
@@ -414,6 +417,7 @@ def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None)
         predict=predict,
         update=update,
         moments=gaussian_moments,
+        root_rows=(lambda model: 2 * model.n_state) if square_root else None,  # M = [U Aᵀ; U_Q]
         prior_many=prior_many,
         predict_many=predict_many,
         update_many=update_many,
@@ -423,31 +427,36 @@ def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None)
 
 
 def _faded(predict, alpha2: float, square_root: bool):
-    r"""Prédiction à mémoire évanescente : :math:`P_{k\mid k-1} = \alpha^2 A P A^T + Q` (la racine de
-    :math:`P` multipliée par :math:`\alpha`)."""
-    alpha = float(np.sqrt(alpha2))
+    r"""Prédiction à mémoire évanescente : :math:`P_{k\mid k-1} = \alpha^2 A P A^T + Q` (en racine carrée,
+    la racine de :math:`P` multipliée par :math:`\alpha`)."""
+    scale = float(np.sqrt(alpha2)) if square_root else alpha2
 
     def faded(model, state, u):
-        if square_root:
-            x, P, U = state
-            return predict(model, (x, alpha2 * P, alpha * U), u)
-        x, P = state
-        return predict(model, (x, alpha2 * P), u)
+        x, P = state  # P, ou sa racine
+        return predict(model, (x, scale * P), u)
 
     return faded
 
 
 def _gated(update, p_gate: float, square_root: bool):
     r"""Correction derrière une porte : si la NIS :math:`\nu^TS^{-1}\nu` dépasse :math:`\chi^2_{m_k}(p)`, la
-    mesure est rejetée (état prédit inchangé, gain nul, ``n_iter`` = 0 : ``result.rejected``)."""
+    mesure est rejetée (état prédit inchangé, gain nul, ``n_iter`` = 0 : ``result.rejected``).
+
+    En racine carrée, l'état porte une racine :math:`M` de :math:`P^-` : :math:`S = (MC^T)^T(MC^T) + R`, et
+    un pas rejeté rend la racine de :math:`S` (``Correction.S``, comme la correction)."""
 
     def gated(model, state, y, idx):
-        x_pred, P_pred = state[0], state[1]
+        x_pred = state[0]
         C, R = _observed_part(model, idx, False)
         nu = y - C.dot(x_pred)
-        S = symmetrize(C.dot(P_pred).dot(C.T) + R)
+        if square_root:  # state[1] : racine M de P⁻
+            MCt = state[1].dot(C.T)
+            S = symmetrize(MCt.T.dot(MCt) + R)
+        else:  # state[1] : P⁻
+            S = symmetrize(C.dot(state[1]).dot(C.T) + R)
         if nis_value(nu, S) > gate_threshold(p_gate, len(nu)):
-            return state, Correction(np.zeros((len(x_pred), len(nu))), nu, S, 0)
+            K = np.zeros((len(x_pred), len(nu)))
+            return state, Correction(K, nu, covariance_root(S) if square_root else S, 0)
         return update(model, state, y, idx)
 
     return gated
