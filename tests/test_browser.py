@@ -350,11 +350,12 @@ def _check_page(site: Site, html_file: Path, visit: Visit, problems: list[str], 
 
 # Toutes les sources tracées de la figure k (une par longueur de série : PLOTTED_SOURCE, PLOTTED_SOURCE-<L>),
 # la position de chaque curseur, ce que chaque curseur affiche et annonce (valeur écrite, aria-label,
-# aria-valuetext : dans les racines fantômes des widgets Bokeh) et le texte de lecture, en un seul aller-retour.
-_READ = """(id) => {
-  const doc = window.kcFigures.documents[id];
+# aria-valuetext : dans les racines fantômes des widgets Bokeh) et le texte de lecture, en un seul aller-retour
+# (``data`` faux : tout sauf les séries, pour attendre que les curseurs soient à jour).
+_READ = """(args) => {
+  const id = args.id, doc = window.kcFigures.documents[id];
   const out = {};
-  for (const m of doc.all_models) {
+  for (const m of args.data ? doc.all_models : []) {
     if (m.name && m.name.startsWith('%s') && m.data) {
       for (const name of Object.keys(m.data)) out[name] = Array.from(m.data[name]);
     }
@@ -384,8 +385,17 @@ _READ = """(id) => {
 def _check_plotted(page, fid: str, grid, name: str | None = None) -> tuple[int, ...]:
     """Relit la figure ``fid`` (:data:`_READ`) : les séries tracées sont celles de la grille au point des
     curseurs, que les curseurs affichent et annoncent aux lecteurs d'écran ; renvoie ce point."""
-    page.wait_for_timeout(20)  # (noUiSlider met à jour aria-valuetext juste après l'événement)
-    state = page.evaluate(_READ, fid)
+    # La valeur écrite et annoncée par le livre remplace celle de Bokeh juste après l'événement : relire
+    # les curseurs (sans les données) jusqu'à ce qu'ils l'affichent, 3 s au plus, puis les données une fois.
+    for _ in range(60):
+        state = page.evaluate(_READ, {"id": fid, "data": False})
+        index = tuple(int(v) if float(v).is_integer() else -1 for v in state["index"])
+        if len(index) == len(grid.axes) and min(index) >= 0:
+            labels = [french_spacing(axis.labels()[i]) for axis, i in zip(grid.axes, index)]
+            if all(sl["shown"] == lab and sl["valuetext"] == lab for sl, lab in zip(state["sliders"], labels)):
+                break
+        page.wait_for_timeout(50)
+    state["data"] = page.evaluate(_READ, {"id": fid, "data": True})["data"]
     assert len(state["index"]) == len(grid.axes)
     assert all(float(v).is_integer() for v in state["index"])
     index = tuple(int(v) for v in state["index"])
