@@ -159,7 +159,7 @@ def bench_browser(root: Path, moves: int, sections: set[str]) -> None:
     server, base = serve(root)
     try:
         with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+            browser = p.chromium.launch(executable_path="/usr/bin/chromium-headless-shell", args=CHROMIUM_ARGS)
             if "poids" in sections:
                 bench_weights(browser, root, base)
             if "réponse" in sections:

@@ -7,6 +7,7 @@
 # La construction échoue sur toute erreur de cellule et tout avertissement Sphinx (-W).
 # Les autres arguments sont transmis à « jupyter-book build ».
 set -euo pipefail
+unset PYTHONDONTWRITEBYTECODE  # code compilé des modules gardé (voir scripts/setup.sh)
 cd "$(dirname "$0")/.."
 
 pdf=0

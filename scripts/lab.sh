@@ -9,6 +9,7 @@
 #
 # Les arguments sont transmis à « jupyter lab » (ex. --no-browser, --port=8890).
 set -euo pipefail
+unset PYTHONDONTWRITEBYTECODE  # code compilé des modules gardé (voir scripts/setup.sh)
 cd "$(dirname "$0")/.."
 
 bash scripts/setup.sh --python-only

@@ -5,6 +5,7 @@
 #   bash scripts/package_tests.sh /usr/bin/python3.13 [arguments de pytest]
 # La CI (.ci/run) le lance avec Python 3.13 quand la machine en a un. Ne touche ni à .venv/ ni à _build/.
 set -euo pipefail
+unset PYTHONDONTWRITEBYTECODE  # code compilé des modules gardé (voir scripts/setup.sh)
 cd "$(dirname "$0")/.."
 python=${1:?utilisation : bash scripts/package_tests.sh CHEMIN_DU_PYTHON [arguments de pytest]}
 shift

@@ -1,4 +1,5 @@
-"""Capture d'écran d'une page du site construit, dans Chromium headless (Debian, /usr/bin/chromium).
+"""Capture d'écran d'une page du site construit, dans Chromium sans écran (Debian,
+/usr/bin/chromium-headless-shell).
 
 Usage : python scripts/screenshot.py _build/html/book/intro.html capture.png [--width 1280] [--full]
 Le site est servi sur 127.0.0.1 (port libre) ; toute requête non locale est bloquée et signalée.
@@ -38,7 +39,7 @@ def main() -> int:
     base = f"http://127.0.0.1:{server.server_address[1]}/"
     blocked: list[str] = []
     with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+        browser = p.chromium.launch(executable_path="/usr/bin/chromium-headless-shell", args=CHROMIUM_ARGS)
         page = browser.new_page(viewport={"width": args.width, "height": args.height})
 
         def route(r):

@@ -10,6 +10,11 @@
 # Python pris en charge parmi python3, python3.13, python3.12, python3.11, /usr/bin/python3.
 # Idempotent : une seconde exécution ne refait que ce qui a changé.
 set -euo pipefail
+# Python garde le code compilé de chaque module importé (__pycache__) : sans lui, chaque processus
+# (noyaux des carnets, constructions, tests) recompile toutes ses bibliothèques, 7 s de calcul de plus
+# pour numpy, scipy, matplotlib, Bokeh et Sphinx. Un environnement qui l'interdit
+# (PYTHONDONTWRITEBYTECODE, posé par certaines images Docker) est corrigé pour ces commandes.
+unset PYTHONDONTWRITEBYTECODE
 cd "$(dirname "$0")/.."
 
 log() { printf '[setup] %s\n' "$*" >&2; }
@@ -29,28 +34,40 @@ SUPPORTED_TEXT="3.11 (dès 3.11.2, celui de Debian 12), 3.12 (celui d'Ubuntu 24.
 python_version() { "$1" -c 'import sys; print("%d.%d.%d" % sys.version_info[:3])' 2>/dev/null; }
 is_supported() { case "$1" in 3.11.0|3.11.1) return 1 ;; 3.11.*|3.12.*|3.13.*) return 0 ;; *) return 1 ;; esac; }
 
-apt_install() {
-  # apt_install RAISON PAQUET… : installe des paquets Debian si l'on est root, sinon explique quoi faire.
-  local why=$1; shift
-  if [ "$(id -u)" = "0" ] && command -v apt-get >/dev/null; then
-    log "installation de $why (apt-get install $*)…"
-    apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@" >/dev/null
-  else
-    log "ERREUR : $why manque. Installez les paquets Debian suivants puis relancez :"
-    log "         sudo apt-get install --no-install-recommends $*"
+# --- paquets Debian et npm, en arrière-plan (pendant l'installation des dépendances Python) -------
+# Chaque téléchargement attend surtout le réseau et le disque : apt-get, npm ci et pip tournent ensemble.
+jobs_pids=()
+start_job() {
+  # start_job NOM COMMANDE… : lance COMMANDE en arrière-plan, son journal dans un fichier temporaire
+  local name=$1; shift
+  local logfile
+  logfile=$(mktemp)
+  ("$@" >"$logfile" 2>&1) &
+  jobs_pids+=($!)
+  eval "job_${name}_pid=$! job_${name}_log=$logfile"
+}
+wait_job() {
+  # wait_job NOM : attend la commande (si elle tourne) ; en cas d'échec, montre son journal et s'arrête
+  local name=$1 pid log
+  eval "pid=\${job_${name}_pid:-} log=\${job_${name}_log:-}"
+  [ -n "$pid" ] || return 0
+  if ! wait "$pid"; then
+    log "ERREUR : $name a échoué ; fin du journal :"
+    tail -n 30 "$log" >&2
     exit 1
   fi
+  eval "job_${name}_pid="
+  rm -f "$log"
 }
+trap 'for p in "${jobs_pids[@]}"; do kill "$p" 2>/dev/null; done; true' EXIT
 
-# --- Chromium (Debian) --------------------------------------------------------------------------
-if [ "$python_only" = 0 ] && [ ! -x /usr/bin/chromium ]; then
-  apt_install "Chromium" chromium
-fi
-
-# --- TeX Live, seulement pour le PDF (--pdf) ------------------------------------------------------
-# XeLaTeX + polyglossia (césure française), latexmk, les classes et extensions LaTeX de Sphinx, les
-# polices FreeFont (celles de Sphinx avec XeLaTeX) et DejaVu, pdftotext (poppler-utils) pour les tests.
+# Chromium sans écran (chromium-headless-shell) : le moteur de Chromium sans interface, fait pour
+# l'automatisation (celui que Playwright prend d'office sans écran) ; un quart de calcul en moins que le
+# navigateur complet pour la même page, et un paquet plus léger. Il dessine les diagrammes Mermaid à la
+# construction et sert aux tests dans le navigateur.
+# TeX Live, seulement pour le PDF (--pdf) : XeLaTeX + polyglossia (césure française), latexmk, les classes
+# et extensions LaTeX de Sphinx, les polices FreeFont (celles de Sphinx avec XeLaTeX) et DejaVu, pdftotext
+# (poppler-utils) pour les tests.
 TEX_PACKAGES=(texlive-xetex texlive-lang-french texlive-latex-recommended texlive-latex-extra
   texlive-fonts-recommended texlive-plain-generic latexmk fonts-freefont-otf fonts-dejavu-core
   fonts-dejavu-extra poppler-utils)
@@ -60,35 +77,35 @@ tex_ready() {
     && kpsewhich fncychap.sty >/dev/null && [ -n "$(fc-list FreeSerif)" ]
   # pas de « fc-list | grep -q » : avec pipefail, grep -q qui s'arrête tôt fait échouer fc-list (SIGPIPE)
 }
+apt_packages=()
+apt_why=()
+if [ "$python_only" = 0 ] && [ ! -x /usr/bin/chromium-headless-shell ]; then
+  apt_packages+=(chromium-headless-shell)
+  apt_why+=("Chromium sans écran")
+fi
 if [ "$want_pdf" = 1 ] && ! tex_ready; then
-  apt_install "TeX Live pour le PDF (XeLaTeX, français)" "${TEX_PACKAGES[@]}"
-  tex_ready || { log "ERREUR : TeX Live installé mais incomplet (xelatex, latexmk, polyglossia, césure fr)"; exit 1; }
+  apt_packages+=("${TEX_PACKAGES[@]}")
+  apt_why+=("TeX Live pour le PDF (XeLaTeX, français)")
 fi
-
-# --- npm, en arrière-plan (pendant l'installation des dépendances Python) -------------------------
-stamp_npm=node_modules/.lock.sha
-want_npm=$(sha256sum package-lock.json | cut -d' ' -f1)
-npm_pid=""
-npm_log=""
-if [ "$python_only" = 0 ] && { [ ! -f "$stamp_npm" ] || [ "$(cat "$stamp_npm")" != "$want_npm" ]; }; then
-  log "installation des ressources npm (npm ci), en parallèle des dépendances Python…"
-  npm_log=$(mktemp)
-  (PUPPETEER_SKIP_DOWNLOAD=true npm ci --no-audit --no-fund --loglevel=error --prefer-offline >"$npm_log" 2>&1) &
-  npm_pid=$!
-fi
-wait_npm() {
-  # attend npm ci (s'il tourne) ; en cas d'échec, montre son journal et s'arrête
-  [ -n "$npm_pid" ] || return 0
-  if ! wait "$npm_pid"; then
-    log "ERREUR : npm ci a échoué ; fin du journal :"
-    tail -n 30 "$npm_log" >&2
+if [ "${#apt_packages[@]}" -gt 0 ]; then
+  why=${apt_why[0]}${apt_why[1]:+ et ${apt_why[1]}}
+  if [ "$(id -u)" = "0" ] && command -v apt-get >/dev/null; then
+    log "installation de $why (apt-get install ${apt_packages[*]}), en parallèle des dépendances Python…"
+    start_job apt bash -c 'apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@"' \
+      apt-get "${apt_packages[@]}"
+  else
+    log "ERREUR : $why manque. Installez les paquets Debian suivants puis relancez :"
+    log "         sudo apt-get install --no-install-recommends ${apt_packages[*]}"
     exit 1
   fi
-  npm_pid=""
-  rm -f "$npm_log"
-  echo "$want_npm" > "$stamp_npm"
-}
-trap '[ -n "$npm_pid" ] && kill "$npm_pid" 2>/dev/null; true' EXIT
+fi
+
+stamp_npm=node_modules/.lock.sha
+want_npm=$(sha256sum package-lock.json | cut -d' ' -f1)
+if [ "$python_only" = 0 ] && { [ ! -f "$stamp_npm" ] || [ "$(cat "$stamp_npm")" != "$want_npm" ]; }; then
+  log "installation des ressources npm (npm ci), en parallèle des dépendances Python…"
+  start_job npm env PUPPETEER_SKIP_DOWNLOAD=true npm ci --no-audit --no-fund --loglevel=error --prefer-offline
+fi
 
 # --- Python -------------------------------------------------------------------------------------
 # PYTHON donné : ce Python (un .venv fait avec un autre est refait). Sinon : le .venv existant s'il est
@@ -167,8 +184,16 @@ mkdir -p .venv/etc/ipython
 cmp -s scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.py \
   || cp scripts/ipython_kernel_config.py .venv/etc/ipython/ipython_kernel_config.py
 
-# --- npm : fin --------------------------------------------------------------------------------
-wait_npm
+# --- npm et paquets Debian : fin ---------------------------------------------------------------
+if [ -n "${job_npm_pid:-}" ]; then
+  wait_job npm
+  echo "$want_npm" > "$stamp_npm"
+fi
+wait_job apt
+if [ "$want_pdf" = 1 ] && ! tex_ready; then
+  log "ERREUR : TeX Live installé mais incomplet (xelatex, latexmk, polyglossia, césure fr)"
+  exit 1
+fi
 
 [ "$python_only" = 1 ] && exit 0
 

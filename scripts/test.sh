@@ -12,6 +12,7 @@
 # Le journal de la session du livre s'affiche à la fin. Avec des arguments, une seule session pytest les
 # reçoit (ex. « bash scripts/test.sh tests/test_kf.py -k joseph »).
 set -euo pipefail
+unset PYTHONDONTWRITEBYTECODE  # code compilé des modules gardé (voir scripts/setup.sh)
 cd "$(dirname "$0")/.."
 case "${CI:-}" in
   ""|false|0) bash scripts/setup.sh ;;

@@ -3,7 +3,7 @@
 book/vendor/ est listé dans html_static_path (copié sous _static/ du site) et exclu des sources ;
 ce n'est pas un dossier « _static » à la racine, que Jupyter Book injecterait dans chaque page.
 
-- MathJax 3 : depuis node_modules/mathjax (npm) ;
+- MathJax 3 (ses polices) : depuis node_modules/mathjax (npm) ;
 - BokehJS (noyau + curseurs) : depuis le paquet Python bokeh installé, donc exactement à la version
   qui produit les figures ; fichiers nommés avec la version (bokeh/bokeh-3.9.2.min.js…). L'extension
   kalman_course.sphinx.sliders vérifie à chaque construction qu'ils sont à jour et ne les
@@ -19,11 +19,10 @@ ROOT = Path(__file__).resolve().parent.parent
 VENDOR = ROOT / "book" / "vendor"
 MATHJAX = ROOT / "node_modules" / "mathjax" / "es5"
 
-# Sous-ensemble de MathJax 3 utile au site (24 Mo → ~3 Mo) : composant TeX + CommonHTML, polices,
-# extensions TeX chargées à la demande (autoload), menu contextuel et accessibilité.
-MATHJAX_PARTS = ["tex-chtml.js", "output/chtml/fonts/woff-v2", "input/tex/extensions", "ui", "a11y", "adaptors",
-                 # composants chargés un à un par startup.js (_config.yml : mathjax_path, mathjax3_config)
-                 "startup.js", "core.js", "input/tex-base.js", "output/chtml.js", "output/chtml/fonts/tex.js"]
+# Ce que le site sert de MathJax 3 : ses polices CHTML (0,3 Mo). Les formules sont composées à la
+# construction, dans node, depuis node_modules/mathjax (kalman_course.sphinx.formulas) : aucune page ne
+# charge les scripts de MathJax.
+MATHJAX_PARTS = ["output/chtml/fonts/woff-v2"]
 
 
 def copy_tree(src: Path, dst: Path) -> None:

@@ -114,3 +114,59 @@ def test_import_check_resolves_relative_imports():
     found = _imported_modules("from ..sphinx import quiz\nfrom docutils import nodes\n", "kalman_course.interactive")
     assert {"kalman_course.sphinx", "kalman_course.sphinx.quiz", "docutils"} <= found
     assert _package_of(PACKAGE / "interactive" / "static.py") == "kalman_course.interactive"
+
+
+# --------------------------------------------------------------------------- formules composées à la construction
+
+_SPHINX_PAGE = """<html><head></head><body><div class="document"><p>Soit
+<span class="math notranslate nohighlight">\\(x^2\\)</span> et <span class="math notranslate nohighlight">\\(a &lt; b\\)</span>.</p>
+<div class="math notranslate nohighlight" id="equation-eq-k">
+<span class="eqno">(1)<a class="headerlink" href="#equation-eq-k" title="Lien vers cette équation">#</a></span>\\[K = \\frac{P}{P + R}\\]</div>
+<pre>\\(pas une formule\\)</pre></div></body></html>"""
+
+
+@pytest.fixture(scope="module")
+def mathjax_settings():
+    import yaml
+
+    config = yaml.safe_load((ROOT / "_config.yml").read_text())["sphinx"]["config"]["mathjax3_config"]
+    return {"mathjax": ROOT / "node_modules" / "mathjax" / "es5", "load": config["loader"]["load"], "tex": config["tex"]}
+
+
+def test_formulas_are_typeset_at_build_time_with_their_mathml(tmp_path, mathjax_settings):
+    """Chaque ``\\(…\\)`` et ``\\[…\\]`` de Sphinx devient la sortie CHTML de MathJax, avec la MathML
+    d'assistance (écrite ici à la main) et le TeX dans ``data-kc-tex`` ; le numéro d'équation et le code
+    restent ; une page déjà composée ne change plus (constructions incrémentales)."""
+    from kalman_course.sphinx.formulas import FONT_URL, typeset_pages
+
+    page = tmp_path / "chapitre.html"
+    page.write_text(_SPHINX_PAGE)
+    css, problems = typeset_pages([page], **mathjax_settings)
+    assert problems == []
+    out = page.read_text()
+    assert out.count("<mjx-container") == 3
+    assert '<math xmlns="http://www.w3.org/1998/Math/MathML"><msup><mi>x</mi><mn>2</mn></msup></math>' in out
+    assert "<mi>a</mi><mo>&lt;</mo><mi>b</mi>" in out
+    assert ("<mi>K</mi><mo>=</mo><mfrac><mi>P</mi><mrow><mi>P</mi><mo>+</mo><mi>R</mi></mrow></mfrac>" in out)
+    assert 'data-kc-tex="a &lt; b"' in out and 'data-kc-tex="K = \\frac{P}{P + R}"' in out
+    assert 'jax="CHTML" display="true"' in out and '<span class="eqno">(1)' in out
+    assert "<pre>\\(pas une formule\\)</pre>" in out
+    assert "\\(x^2" not in out and "\\[K" not in out
+    # la feuille commune : polices servies par le site, relatives à _static/kc/
+    fonts = ROOT / "book" / "vendor" / "kc"
+    urls = set(__import__("re").findall(r'url\("?([^")]+\.woff)', css))
+    assert urls and all(u.startswith(FONT_URL) for u in urls)
+    assert all((fonts / u).resolve().is_file() for u in urls), sorted(urls)[:3]
+    again, _ = typeset_pages([page], **mathjax_settings)
+    assert page.read_text() == out and again == css
+
+
+def test_a_formula_mathjax_refuses_names_its_page(tmp_path, mathjax_settings):
+    from kalman_course.sphinx.formulas import typeset_pages
+
+    page = tmp_path / "td.html"
+    page.write_text('<span class="math notranslate nohighlight">\\(\\hatx + 1\\)</span>'
+                    '<span class="math notranslate nohighlight">\\(\\frac{1}{\\)</span>')
+    _, problems = typeset_pages([page], **mathjax_settings)
+    assert problems == ["td.html : « \\hatx + 1 » : commande inconnue \\hatx",
+                        "td.html : « \\frac{1}{ » : Missing close brace"]

@@ -1,10 +1,11 @@
-"""Le site construit dans Chromium headless (Debian, /usr/bin/chromium), sans réseau.
+"""Le site construit dans Chromium sans écran (Debian, /usr/bin/chromium-headless-shell), sans réseau.
 
 Le site est servi sur 127.0.0.1 (port libre) ; toute requête non locale est interceptée, bloquée et
-fait échouer le test. Pour chaque page : aucune erreur de page ni de console, formules typographiées
-par MathJax (servi par le site), diagrammes mermaid dessinés, aucune violation grave ou critique
-d'axe-core (règles WCAG 2.0/2.1 A et AA, le paquet npm de package-lock.json injecté dans la page,
-après le dessin des curseurs et des formules), au moins 2,5 Mo au premier chargement. Sur les pages à
+fait échouer le test. Pour chaque page : aucune erreur de page ni de console, formules composées à la
+construction (sortie CHTML de MathJax dans la page, sans script MathJax : kalman_course.sphinx.formulas),
+diagrammes mermaid dessinés, aucune violation grave ou critique d'axe-core (règles WCAG 2.0/2.1 A et AA,
+le paquet npm de package-lock.json injecté dans la page, après le dessin des curseurs), au plus 2,5 Mo
+au premier chargement. Sur les pages à
 curseurs statiques : les curseurs sont déplacés par de vrais événements clavier et souris, et les
 données tracées, relues dans le document Bokeh, sont comparées aux exécutions calculées ici par le
 paquet. Un portable (1366 × 768) voit chaque panneau avec ses curseurs ; un téléphone (390 × 844, mode
@@ -26,6 +27,7 @@ from __future__ import annotations
 import functools
 import http.server
 import os
+import queue
 import re
 import threading
 from collections import defaultdict
@@ -46,7 +48,7 @@ from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
 pytestmark = pytest.mark.browser
 
 ROOT = Path(__file__).resolve().parent.parent
-CHROMIUM = "/usr/bin/chromium"
+CHROMIUM = "/usr/bin/chromium-headless-shell"
 CHROMIUM_ARGS = [
     "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
     "--disable-background-networking", "--disable-component-update", "--disable-sync",
@@ -58,8 +60,29 @@ CHROMIUM_ARGS = [
 #: Annexes du livre (ni figure à curseurs, ni quiz).
 APPENDICES = {"references", "errata", "glossaire"}
 
-#: Figures à curseurs statiques connues → grille attendue (calculée ici par le paquet, depuis son registre).
-EXPECTED_GRIDS = {name: (lambda name=name: ki.slider_grid(name)) for name in ki.slider_names()}
+
+
+class GridPoints:
+    """Les points de la grille d'une figure à curseurs que la visite relit, calculés ici par le paquet un à
+    un (:meth:`~kalman_course.interactive.figure.SliderSpec.run_at` : les mêmes appels de ``run`` que pour
+    la grille, tests/test_slider_grids.py le vérifie) plutôt que la grille entière : axes, abscisse commune,
+    position par défaut, ``run(*index)``."""
+
+    def __init__(self, name: str):
+        self.spec = ki.slider_spec(name)
+        self.axes, self.time = self.spec.axes, self.spec.time
+        self.shape = tuple(axis.values.size for axis in self.axes)
+        self.default_index = tuple(axis.default for axis in self.axes)
+        self._runs: dict[tuple[int, ...], dict[str, np.ndarray]] = {}
+
+    def run(self, *index: int) -> dict[str, np.ndarray]:
+        if index not in self._runs:
+            self._runs[index] = self.spec.run_at(*index)
+        return self._runs[index]
+
+
+#: Figures à curseurs statiques connues (registre du paquet) → leurs points de grille.
+EXPECTED_GRIDS = {name: (lambda name=name: GridPoints(name)) for name in ki.slider_names()}
 
 
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):
@@ -97,7 +120,7 @@ def site(request):
 @pytest.fixture(scope="module")
 def browser():
     if not Path(CHROMIUM).exists():
-        pytest.fail(f"{CHROMIUM} absent : installez le paquet Debian « chromium » (scripts/setup.sh le fait).")
+        pytest.fail(f"{CHROMIUM} absent : installez le paquet Debian « chromium-headless-shell » (scripts/setup.sh le fait).")
     with playwright_api.sync_playwright() as p:
         b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         yield b
@@ -130,7 +153,7 @@ def open_page(browser, url: str, allowed_prefix: str, *, viewport=LAPTOP, color_
               figures: bool = True) -> Visit:
     """Ouvre ``url`` en bloquant (et notant) toute requête qui ne commence pas par ``allowed_prefix``.
 
-    Après le chargement et la composition des formules, ``first_load`` note les adresses chargées (le
+    Après le chargement, ``first_load`` note les adresses chargées (le
     premier chargement) ; puis, si ``figures``, toutes les figures à curseurs de la page sont dessinées
     (elles se chargent d'ordinaire quand elles approchent de l'écran).
     """
@@ -151,9 +174,7 @@ def open_page(browser, url: str, allowed_prefix: str, *, viewport=LAPTOP, color_
     page.on("console", lambda m: visit.console.append(m.text) if m.type == "error" else None)
     page.on("response", lambda r: (visit.broken if r.status >= 400 else visit.loaded).append(r.url))
     page.on("requestfailed", lambda r: None if r.url in visit.blocked else visit.broken.append(r.url))
-    page.goto(url, wait_until="load")
-    # MathJax (chargé en « defer ») : attendre la fin de la composition initiale
-    page.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise.then(() => true) : true")
+    page.goto(url, wait_until="load")  # (formules composées à la construction : rien à attendre)
     visit.first_load = list(visit.loaded)
     if figures:
         load_figures(page)
@@ -295,6 +316,10 @@ def _check_page(site: Site, html_file: Path, visit: Visit, problems: list[str], 
     if '<span class="math' in html or '<div class="math' in html:
         if page.locator("mjx-container").count() == 0:
             problems.append(f"{name} : aucune sortie MathJax")
+    mathjax_js = [u for u in visit.loaded if "/_static/mathjax/" in u and urlsplit(u).path.endswith(".js")]
+    if mathjax_js or page.evaluate("() => !!window.MathJax"):
+        problems.append(f"{name} : MathJax chargé par la page ({mathjax_js[:2]}) : les formules sont composées "
+                        f"à la construction")
     prose = page.evaluate(_PROSE)
     for kind, label in (("tex", "TeX brut visible"), ("english", "nombre à l'anglaise dans le texte"),
                         ("space", "espace ordinaire devant « : ; ? ! »"),
@@ -434,7 +459,7 @@ def _weight(visit: Visit, site: Site, html_file: Path) -> dict[str, int]:
     images = {(html_file.parent / src).resolve() for src in re.findall(r'<img[^>]+src="([^"]+)"', html)}
     sizes = {"page HTML (données incluses)": html_file.stat().st_size,
              "images du chapitre": sum(f.stat().st_size for f in images if f.is_file()),
-             "BokehJS (partagé)": 0, "MathJax (partagé)": 0, "thème et autres scripts (partagés)": 0}
+             "BokehJS (partagé)": 0, "formules (feuille et polices, partagées)": 0, "thème et autres scripts (partagés)": 0}
     for url in dict.fromkeys(visit.loaded):
         f = site.file_for(url).resolve()
         if not f.is_file() or f == html_file.resolve() or f in images:
@@ -442,8 +467,8 @@ def _weight(visit: Visit, site: Site, html_file: Path) -> dict[str, int]:
         rel = f.relative_to(site.root.resolve()).as_posix()
         if rel.startswith("_static/bokeh/"):
             sizes["BokehJS (partagé)"] += f.stat().st_size
-        elif rel.startswith("_static/mathjax/"):
-            sizes["MathJax (partagé)"] += f.stat().st_size
+        elif rel.startswith("_static/mathjax/") or rel == "_static/kc/kc-formulas.css":
+            sizes["formules (feuille et polices, partagées)"] += f.stat().st_size
         elif not rel.startswith("_images/"):
             sizes["thème et autres scripts (partagés)"] += f.stat().st_size
     return sizes
@@ -659,8 +684,8 @@ def _check_panels(site: Site, html_file: Path, visit: Visit, problems: list[str]
 
 @dataclass
 class Tour:
-    """Ce qu'a trouvé la visite des pages sur un portable : par vérification, les pages vues, les problèmes
-    et le compte rendu."""
+    """Ce qu'a trouvé une visite (d'une page, ou de toutes les pages sur un écran) : par vérification, les
+    pages vues, les problèmes et le compte rendu."""
 
     visited: dict[str, list[str]] = field(default_factory=lambda: defaultdict(list))
     problems: dict[str, list[str]] = field(default_factory=lambda: defaultdict(list))
@@ -694,68 +719,93 @@ def _phone_checks(html_file: Path, html: str, toc: set[Path]) -> list[tuple[str,
     return checks
 
 
-def _tour(site: Site, checks_of: Callable, viewport: dict, color_scheme: str) -> Tour:
-    """Chaque page du site ouverte **une fois** (formules composées, figures dessinées) dans un Chromium à
-    soi ; les vérifications ``checks_of(page)`` s'y suivent et notent leurs problèmes à part. Une
-    vérification qui lève une exception (assertion, délai de Playwright) compte comme un problème de la
-    page, et les suivantes passent quand même."""
+def _visit_page(browser, site: Site, html_file: Path, checks_of: Callable, viewport: dict,
+                color_scheme: str, toc: set[Path]) -> Tour:
+    """Une page ouverte **une fois** (figures dessinées) ; les vérifications ``checks_of(page)`` s'y
+    suivent et notent leurs problèmes à part. Une vérification qui lève une exception (assertion, délai
+    de Playwright) compte comme un problème de la page, et les suivantes passent quand même."""
     tour = Tour()
-    toc = set(_toc_pages(site.root))
-    with playwright_api.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        for html_file in html_pages(site.root):
-            html = html_file.read_text()
-            name = html_file.relative_to(site.root).as_posix()
-            redirect = re.search(r'http-equiv="refresh" content="0; url=([^"]+)"', html, re.I)
-            if redirect:  # page de redirection (index.html → première page) : la cible doit exister
-                if checks_of is _laptop_checks:
-                    tour.visited["pages"].append(name)
-                    if not (html_file.parent / redirect[1]).is_file():
-                        tour.problems["pages"].append(f"{name} : redirection vers {redirect[1]} introuvable")
-                continue
-            checks = checks_of(html_file, html, toc)
-            try:
-                visit = open_page(browser, site.url(html_file), site.base, viewport=viewport, color_scheme=color_scheme)
-            except playwright_api.Error as exc:
-                for key, _ in checks:
-                    tour.visited[key].append(name)
-                    tour.problems[key].append(f"{name} : la page ne s'ouvre pas ({type(exc).__name__} : {exc})")
-                continue
-            for key, check in checks:
-                tour.visited[key].append(name)
-                try:
-                    check(site, html_file, visit, tour.problems[key], tour.reports[key])
-                except (AssertionError, playwright_api.Error) as exc:
-                    tour.problems[key].append(f"{name} : {type(exc).__name__} : {exc}")
-            visit.page.context.close()
-        browser.close()
+    html = html_file.read_text()
+    name = html_file.relative_to(site.root).as_posix()
+    redirect = re.search(r'http-equiv="refresh" content="0; url=([^"]+)"', html, re.I)
+    if redirect:  # page de redirection (index.html → première page) : la cible doit exister
+        if checks_of is _laptop_checks:
+            tour.visited["pages"].append(name)
+            if not (html_file.parent / redirect[1]).is_file():
+                tour.problems["pages"].append(f"{name} : redirection vers {redirect[1]} introuvable")
+        return tour
+    checks = checks_of(html_file, html, toc)
+    try:
+        visit = open_page(browser, site.url(html_file), site.base, viewport=viewport, color_scheme=color_scheme)
+    except playwright_api.Error as exc:
+        for key, _ in checks:
+            tour.visited[key].append(name)
+            tour.problems[key].append(f"{name} : la page ne s'ouvre pas ({type(exc).__name__} : {exc})")
+        return tour
+    for key, check in checks:
+        tour.visited[key].append(name)
+        try:
+            check(site, html_file, visit, tour.problems[key], tour.reports[key])
+        except (AssertionError, playwright_api.Error) as exc:
+            tour.problems[key].append(f"{name} : {type(exc).__name__} : {exc}")
+    visit.page.context.close()
     return tour
+
+
+#: Visiteurs par écran : chaque visiteur est un fil avec son Playwright et son Chromium, qui prend la page
+#: suivante de la file de son écran. (Une visite attend surtout Chromium et le pilote de Playwright :
+#: un visiteur occupe environ un tiers de cœur.)
+VISITORS_PER_SCREEN = 2
 
 
 @pytest.fixture(scope="module")
 def tours(site) -> tuple[Tour, Tour]:
-    """Deux visites de chaque page, en même temps (deux Chromium, un fil chacun, avec leur propre Playwright :
-    un par cœur) : sur un portable en mode clair (:func:`_laptop_checks`) et sur un téléphone en mode sombre
-    (:func:`_phone_checks`). Chaque test ci-dessous lit les problèmes de sa vérification. (Une visite par
-    test coûtait six chargements de chaque page, l'un après l'autre.)"""
-    results: dict[str, object] = {}
+    """Deux visites de chaque page : sur un portable en mode clair (:func:`_laptop_checks`) et sur un
+    téléphone en mode sombre (:func:`_phone_checks`), par :data:`VISITORS_PER_SCREEN` visiteurs par écran,
+    tous en même temps. Chaque test ci-dessous lit les problèmes de sa vérification ; les pages y sont
+    dans l'ordre du site. (Une visite par test coûtait six chargements de chaque page, l'un après l'autre.)"""
+    pages = html_pages(site.root)
+    toc = set(_toc_pages(site.root))
+    screens = {"portable": (_laptop_checks, LAPTOP, "light"), "téléphone": (_phone_checks, PHONE, "dark")}
+    queues = {label: queue.SimpleQueue() for label in screens}
+    for q in queues.values():
+        for html_file in sorted(pages, key=lambda f: -f.stat().st_size):  # les plus longues d'abord
+            q.put(html_file)
+    found: dict[tuple[str, Path], Tour] = {}
+    errors: list[BaseException] = []
 
-    def run(label, checks_of, viewport, color_scheme):
+    def visitor(label):
+        checks_of, viewport, color_scheme = screens[label]
         try:
-            results[label] = _tour(site, checks_of, viewport, color_scheme)
+            with playwright_api.sync_playwright() as p:
+                browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+                while True:
+                    try:
+                        html_file = queues[label].get_nowait()
+                    except queue.Empty:
+                        break
+                    found[label, html_file] = _visit_page(browser, site, html_file, checks_of, viewport,
+                                                          color_scheme, toc)
+                browser.close()
         except BaseException as exc:  # relevée dans le fil principal
-            results[label] = exc
+            errors.append(exc)
 
-    threads = [threading.Thread(target=run, args=args, name=args[0]) for args in
-               (("portable", _laptop_checks, LAPTOP, "light"), ("téléphone", _phone_checks, PHONE, "dark"))]
+    threads = [threading.Thread(target=visitor, args=(label,), name=f"{label}-{k}")
+               for k in range(VISITORS_PER_SCREEN) for label in screens]
     for thread in threads:
         thread.start()
     for thread in threads:
         thread.join()
-    for outcome in results.values():
-        if isinstance(outcome, BaseException):
-            raise outcome
-    return results["portable"], results["téléphone"]
+    if errors:
+        raise errors[0]
+    merged = {label: Tour() for label in screens}
+    for label, tour in merged.items():
+        for html_file in pages:
+            part = found[label, html_file]
+            for field_name in ("visited", "problems", "reports"):
+                for key, items in getattr(part, field_name).items():
+                    getattr(tour, field_name)[key].extend(items)
+    return merged["portable"], merged["téléphone"]
 
 
 def test_every_page_is_offline_typeset_and_drawn(tours, capsys):
@@ -824,7 +874,12 @@ _PHONE = r"""() => {
     }
     const wide = m.scrollWidth > m.getBoundingClientRect().width + 1 ||
                  m.getBoundingClientRect().right > window.innerWidth + 1;
-    if (wide && !scrolls) out.cut.push(m.textContent.slice(0, 40));
+    // … et son début doit être atteignable : pas à gauche de son cadre (une équation centrée qui déborde
+    // y perd son début)
+    const math = m.querySelector('mjx-math');
+    const start = scrolls ? box.getBoundingClientRect().left : 0;
+    const lost = math && math.getBoundingClientRect().left < start - 1;
+    if ((wide && !scrolls) || lost) out.cut.push((m.dataset.kcTex || m.textContent).slice(0, 40));
   }
   return out;
 }"""
@@ -923,7 +978,7 @@ def test_keyboard_reaches_the_first_slider_in_a_few_keys(site, browser, capsys):
     focused = page.evaluate(_FOCUSED)
     assert "noUi-handle" in focused["cls"], focused
     spec = ki.slider_spec(page.locator(f"[{MARKER}]").first.get_attribute(MARKER))
-    axis = spec.grid().axes[0]
+    axis = spec.axes[0]
     assert focused["label"] == french_spacing(f"{axis.symbol} — {axis.description}")
     handle = page.locator(".noUi-handle").first
     assert handle.get_attribute("aria-valuetext") == french_spacing(axis.labels()[axis.default])

@@ -112,6 +112,27 @@ def test_every_slider_figure_builds_with_labels_units_and_its_default_readout(na
         assert not re.search(r"\de[-+]?\d", text), text  # jamais de notation « e-05 »
 
 
+@pytest.mark.parametrize("name", ki.slider_names())
+def test_a_point_computed_alone_equals_the_grid(name):
+    """``run_at`` (une exécution, sans la grille : la relecture du navigateur s'en sert) donne exactement la
+    série de la grille, aux coins et au défaut : ``run`` ne dépend pas de l'ordre des appels. (Description
+    reconstruite par son registre : sa grille n'est pas encore calculée.)"""
+    grid = ki.slider_grid(name)
+    fresh = ki.figure.SLIDER_FIGURES[name][1]()
+    corners = [tuple(0 if c == 0 else n - 1 for c, n in zip(bits, grid.shape))
+               for bits in np.ndindex(*(2,) * len(grid.shape))]
+    for index in dict.fromkeys([grid.default_index] + corners[::-1]):
+        alone = fresh.run_at(*index)
+        assert fresh._grid is None
+        assert alone.keys() == grid.series.keys()
+        for series, values in grid.run(*index).items():
+            np.testing.assert_array_equal(alone[series], values, err_msg=f"{name}, série {series}, point {index}")
+    if fresh.readout is not None:
+        assert fresh.text_at(*grid.default_index) == ki.slider_spec(name).text_at(*grid.default_index)
+    with pytest.raises(kc.KalmanInputError, match="hors de la grille"):
+        fresh.run_at(*grid.shape)
+
+
 # --------------------------------------------------------------------------- introduction et intuition
 
 

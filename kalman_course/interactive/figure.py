@@ -87,12 +87,30 @@ class SliderSpec:
             self._grid = precompute_grid(self.run, *self.axes, time=self.time)
         return self._grid
 
+    def values_at(self, *index: int) -> tuple[float, ...]:
+        """Les valeurs des paramètres au point de grille ``index`` (un indice par curseur)."""
+        shape = tuple(axis.values.size for axis in self.axes)
+        if len(index) != len(shape) or not all(
+            isinstance(i, (int, np.integer)) and not isinstance(i, bool) and 0 <= i < n for i, n in zip(index, shape)
+        ):
+            raise KalmanInputError(
+                f"Point de grille {tuple(index)} hors de la grille {' × '.join(map(str, shape))} de « {self.name} »."
+            )
+        return tuple(float(axis.values[i]) for axis, i in zip(self.axes, index))
+
+    def run_at(self, *index: int) -> dict[str, np.ndarray]:
+        """L'exécution au point de grille ``index`` : ``grid().run(*index)``, sans calculer toute la grille
+        quand elle ne l'est pas encore (``run`` appelé avec les mêmes valeurs que pour la grille ; séries
+        ``float64`` de forme (L,))."""
+        if self._grid is not None:
+            return self._grid.run(*index)
+        return {name: np.asarray(values, dtype=float) for name, values in self.run(*self.values_at(*index)).items()}
+
     def text_at(self, *index: int) -> str:
         """Le texte de lecture au point de grille ``index`` (vide sans ``readout``)."""
         if self.readout is None:
             return ""
-        grid = self.grid()
-        return self.readout(grid.run(*index), grid.values_at(*index))
+        return self.readout(self.run_at(*index), self.values_at(*index))
 
     def static(self):
         """La figure à curseurs statiques (Bokeh) du livre publié."""

@@ -14,6 +14,7 @@ sphinxcontrib-bibtex mêle par défaut deux styles : « (Welch and Bishop, 2006)
 
 from __future__ import annotations
 
+import functools
 from collections import Counter
 from dataclasses import dataclass
 
@@ -238,11 +239,36 @@ def _reference_style():
     return FrenchAuthorYear
 
 
+def _cache_pybtex_entry_points() -> None:
+    """pybtex cherche chaque greffon (style, format de sortie…) parmi les points d'entrée de *tous* les
+    paquets installés, à chaque rendu d'un texte : 30 ms par recherche, 22 s par construction du livre
+    pour ses 68 références (``importlib.metadata.entry_points`` relit les métadonnées à chaque appel).
+    Les paquets installés ne changent pas pendant une construction : la réponse est gardée par (groupe,
+    nom). Les greffons enregistrés à l'exécution (``register_plugin``) passent toujours avant."""
+    import pybtex.plugin
+
+    if getattr(pybtex.plugin.entry_points, "kc_cached", False):
+        return
+    lookup = pybtex.plugin.entry_points
+
+    @functools.lru_cache(maxsize=None)
+    def cached(group, name):
+        return lookup(group=group, name=name) if name is not None else lookup(group=group)
+
+    def entry_points(*, group, name=None):
+        return cached(group, name)
+
+    entry_points.kc_cached = True
+    pybtex.plugin.entry_points = entry_points
+
+
 def register() -> None:
     """Enregistre les trois greffons (étiquettes, liste, renvois) auprès de pybtex et de
     sphinxcontrib-bibtex (sans effet s'ils le sont déjà)."""
     import pybtex.plugin
     import sphinxcontrib.bibtex.plugin
+
+    _cache_pybtex_entry_points()
 
     for group, name, factory in (
         ("pybtex.style.labels", "kc_auteur_annee", _label_style),

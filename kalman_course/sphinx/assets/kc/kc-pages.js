@@ -180,6 +180,14 @@
       b.removeAttribute("aria-label");
     });
 
+    // Formules à la hauteur d'x du texte (ce que ferait MathJax dans la page : x des polices TeX = 0,442 em).
+    var probe = document.createElement("span");
+    probe.style.cssText = "position:absolute;visibility:hidden;width:100ex;height:0;font-size:100px";
+    document.body.appendChild(probe);
+    var ex = probe.getBoundingClientRect().width / 100 / 100;
+    document.body.removeChild(probe);
+    if (ex > 0.2 && ex < 0.8) document.documentElement.style.setProperty("--kc-math-scale", (ex / 0.442).toFixed(3));
+
     // Équations hors cadre (petit écran) : défilement horizontal, au clavier aussi.
     var scrollable = function () {
       document.querySelectorAll("mjx-container[display='true']").forEach(function (m) {
@@ -195,15 +203,9 @@
         }
       });
     };
-    if (window.MathJax && window.MathJax.startup && window.MathJax.startup.promise) {
-      window.MathJax.startup.promise.then(scrollable);
-    } else {
-      window.addEventListener("load", function () {
-        if (window.MathJax && window.MathJax.startup && window.MathJax.startup.promise) {
-          window.MathJax.startup.promise.then(scrollable);
-        }
-      });
-    }
+    // (formules composées à la construction : kalman_course.sphinx.formulas ; polices chargées à « load »)
+    scrollable();
+    window.addEventListener("load", scrollable);
     window.addEventListener("resize", scrollable);
 
     // Recherche : extraits sans TeX brut.
@@ -260,12 +262,20 @@
   }
   window.kcTexToText = texToText;
 
+  function decode(text) {  // entités HTML de la page (&lt; …) décodées sans rien exécuter
+    var area = document.createElement("textarea");
+    area.innerHTML = text;
+    return area.value;
+  }
+
   function readableMath(htmlText) {
+    // formules composées à la construction : leur TeX est dans data-kc-tex (kalman_course.sphinx.formulas)
+    htmlText = htmlText.replace(/<mjx-container[^>]*\sdata-kc-tex="([^"]*)"[^>]*>[\s\S]*?<\/mjx-container>/g,
+      function (m, tex) {
+        return texToText(decode(tex)).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;");
+      });
     return htmlText.replace(/\\\(([\s\S]*?)\\\)|\\\[([\s\S]*?)\\\]|\$\$([\s\S]*?)\$\$/g, function (m, a, b, c) {
-      var tex = a !== undefined ? a : (b !== undefined ? b : c);
-      var area = document.createElement("textarea");
-      area.innerHTML = tex;  // décode les entités HTML de la page (&lt; …) sans rien exécuter
-      return texToText(area.value);
+      return texToText(decode(a !== undefined ? a : (b !== undefined ? b : c)));
     });
   }
   window.kcReadableMath = readableMath;
