@@ -59,7 +59,7 @@ wait_job() {
   eval "job_${name}_pid="
   rm -f "$log"
 }
-trap 'for p in "${jobs_pids[@]}"; do kill "$p" 2>/dev/null; done; true' EXIT
+trap 'for p in "${jobs_pids[@]}"; do kill "$p" 2>/dev/null || true; done' EXIT
 
 # Chromium sans écran (chromium-headless-shell) : le moteur de Chromium sans interface, fait pour
 # l'automatisation (celui que Playwright prend d'office sans écran) ; un quart de calcul en moins que le
