@@ -6,6 +6,7 @@
 # La CI (.ci/run) le lance avec Python 3.13 quand la machine en a un. Ne touche ni à .venv/ ni à _build/.
 set -euo pipefail
 unset PYTHONDONTWRITEBYTECODE  # code compilé des modules gardé (voir scripts/setup.sh)
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1  # un fil d'algèbre linéaire (voir scripts/test.sh)
 cd "$(dirname "$0")/.."
 python=${1:?utilisation : bash scripts/package_tests.sh CHEMIN_DU_PYTHON [arguments de pytest]}
 shift
@@ -19,11 +20,7 @@ if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
   rm -rf "$venv"
   log "environnement $venv ($python), requirements.txt…"
   "$python" -m venv "$venv"
-  if ! "$venv/bin/python" -m pip install -q --no-compile --disable-pip-version-check -r requirements.txt >"$venv/pip-install.log" 2>&1; then
-    log "ERREUR : pip install a échoué ; fin du journal ($venv/pip-install.log) :"
-    grep -v "^WARNING: Location" "$venv/pip-install.log" | tail -n 30 >&2
-    exit 1
-  fi
+  bash scripts/install_requirements.sh "$venv"
   echo "$want" > "$stamp"
 fi
 log "pytest (tests du paquet : ni livre, ni navigateur, ni PDF)…"

@@ -159,22 +159,10 @@ fi
 v=$(python_version .venv/bin/python)
 stamp=.venv/.requirements.sha
 want=$( (cat requirements.txt pyproject.toml; echo "$v") | sha256sum | cut -d' ' -f1)
-pip_quiet() {
-  # pip dans un journal ; en cas d'échec, on montre la fin du journal et on s'arrête. --no-compile : pip ne
-  # compile pas d'avance chaque .py installé ; Python compile à l'import
-  # ceux qui servent.
-  local logfile=.venv/pip-install.log
-  if ! .venv/bin/python -m pip install -q --no-compile --disable-pip-version-check "$@" >"$logfile" 2>&1; then
-    log "ERREUR : pip install $* a échoué (Python $v) ; fin du journal ($logfile) :"
-    grep -v "^WARNING: Location" "$logfile" | tail -n 30 >&2
-    log "Pythons pris en charge : $SUPPORTED_TEXT."
-    exit 1
-  fi
-}
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
-  log "installation des dépendances Python (requirements.txt, Python $v)…"
-  pip_quiet -r requirements.txt
-  pip_quiet --no-deps -e .
+  log "installation des dépendances Python (requirements.txt par uv, Python $v)…"
+  bash scripts/install_requirements.sh .venv --editable \
+    || { log "Pythons pris en charge : $SUPPORTED_TEXT."; exit 1; }
   .venv/bin/python -c "import kalman_course, kalman_course.interactive, filterpy, myst_nb" \
     || { log "ERREUR : installation Python incomplète"; exit 1; }
   echo "$want" > "$stamp"

@@ -13,6 +13,10 @@
 # reçoit (ex. « bash scripts/test.sh tests/test_kf.py -k joseph »).
 set -euo pipefail
 unset PYTHONDONTWRITEBYTECODE  # code compilé des modules gardé (voir scripts/setup.sh)
+# Une algèbre linéaire (BLAS) sur un fil par processus : les tests font de petits calculs, plusieurs
+# processus à la fois (deux sessions, noyaux, constructions) ; les fils d'OpenBLAS, qui attendent du travail
+# en tournant, y prenaient 18 % de calcul de plus pour la même durée.
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
 cd "$(dirname "$0")/.."
 case "${CI:-}" in
   ""|false|0) bash scripts/setup.sh ;;
