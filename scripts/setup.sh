@@ -21,12 +21,17 @@ log() { printf '[setup] %s\n' "$*" >&2; }
 
 want_pdf=0
 python_only=0   # --python-only : .venv seulement (scripts/lab.sh : ni Chromium, ni npm, ni ressources web)
-for arg in "$@"; do
-  case "$arg" in
+system_later="" # --system-later FICHIER : paquets Debian installés en arrière-plan, sans les attendre
+while [ "$#" -gt 0 ]; do
+  case "$1" in
     --pdf) want_pdf=1 ;;
     --python-only) python_only=1 ;;
-    *) log "ERREUR : option inconnue « $arg » (options : --pdf, --python-only)"; exit 2 ;;
+    --system-later)
+      system_later=${2:?--system-later demande un fichier}
+      shift ;;
+    *) log "ERREUR : option inconnue « $1 » (options : --pdf, --python-only, --system-later FICHIER)"; exit 2 ;;
   esac
+  shift
 done
 
 # Pythons pris en charge : ceux sur lesquels requirements.txt s'installe et les tests passent.
@@ -90,14 +95,26 @@ fi
 if [ "${#apt_packages[@]}" -gt 0 ]; then
   why=${apt_why[0]}${apt_why[1]:+ et ${apt_why[1]}}
   if [ "$(id -u)" = "0" ] && command -v apt-get >/dev/null; then
-    log "installation de $why (apt-get install ${apt_packages[*]}), en parallèle des dépendances Python…"
-    start_job apt bash -c 'apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@"' \
-      apt-get "${apt_packages[@]}"
+    apt_command=(bash -c 'apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@"'
+                 apt-get "${apt_packages[@]}")
+    if [ -n "$system_later" ]; then
+      # scripts/test.sh : les carnets n'ont besoin ni de Chromium ni de TeX Live ; la construction du site et
+      # le PDF attendent la fin de l'installation (scripts/wait_system.sh), qui écrit son code dans le fichier.
+      log "installation de $why (apt-get install ${apt_packages[*]}), en arrière-plan…"
+      rm -f "$system_later"
+      ( "${apt_command[@]}"; echo $? >"$system_later.code"; mv "$system_later.code" "$system_later" ) \
+        >"$system_later.log" 2>&1 </dev/null &
+    else
+      log "installation de $why (apt-get install ${apt_packages[*]}), en parallèle des dépendances Python…"
+      start_job apt "${apt_command[@]}"
+    fi
   else
     log "ERREUR : $why manque. Installez les paquets Debian suivants puis relancez :"
     log "         sudo apt-get install --no-install-recommends ${apt_packages[*]}"
     exit 1
   fi
+elif [ -n "$system_later" ]; then
+  echo 0 >"$system_later"
 fi
 
 stamp_npm=node_modules/.lock.sha
@@ -178,7 +195,7 @@ if [ -n "${job_npm_pid:-}" ]; then
   echo "$want_npm" > "$stamp_npm"
 fi
 wait_job apt
-if [ "$want_pdf" = 1 ] && ! tex_ready; then
+if [ "$want_pdf" = 1 ] && [ -z "$system_later" ] && ! tex_ready; then
   log "ERREUR : TeX Live installé mais incomplet (xelatex, latexmk, polyglossia, césure fr)"
   exit 1
 fi

@@ -5,7 +5,7 @@
 # en CI (CI=true), sinon par « bash scripts/setup.sh --pdf » (sans TeX Live, hors CI, ce test est sauté
 # avec un message).
 #
-# Sans argument, deux sessions pytest tournent en même temps (celle du paquet en priorité basse) :
+# Sans argument, deux sessions pytest tournent en même temps :
 #   - le livre (marqueurs book, browser, pdf) : carnets exécutés en parallèle puis site construit, tests du
 #     site et du navigateur pendant que le PDF se construit, tests du PDF (voir tests/conftest.py) ;
 #   - le paquet : tous les autres tests.
@@ -18,9 +18,13 @@ unset PYTHONDONTWRITEBYTECODE  # code compilé des modules gardé (voir scripts/
 # en tournant, y prenaient 18 % de calcul de plus pour la même durée.
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
 cd "$(dirname "$0")/.."
+# Les paquets Debian (Chromium sans écran, TeX Live) s'installent en arrière-plan : les carnets n'en ont pas
+# besoin ; la construction du site et le PDF attendent leur fin (scripts/wait_system.sh, KALMAN_SYSTEM_SETUP).
+KALMAN_SYSTEM_SETUP=$(mktemp -u "${TMPDIR:-/tmp}/kalman-paquets-debian.XXXXXX")
+export KALMAN_SYSTEM_SETUP
 case "${CI:-}" in
-  ""|false|0) bash scripts/setup.sh ;;
-  *) bash scripts/setup.sh --pdf ;;
+  ""|false|0) bash scripts/setup.sh --system-later "$KALMAN_SYSTEM_SETUP" ;;
+  *) bash scripts/setup.sh --pdf --system-later "$KALMAN_SYSTEM_SETUP" ;;
 esac
 if [ "$#" -gt 0 ]; then
   exec .venv/bin/python -m pytest "$@"
@@ -32,9 +36,10 @@ book_log=$(mktemp)
 book_pid=$!
 trap 'kill "$book_pid" 2>/dev/null; true' INT TERM
 package=0
-# La session du livre est le chemin critique (carnets, site, navigateur, PDF, l'un après l'autre) ; celle du
-# paquet, en priorité basse, prend le temps de calcul qu'elle laisse.
-nice -n 10 .venv/bin/python -m pytest -m "not ($BOOK_MARKS)" || package=$?
+# Les deux sessions à la même priorité : le système partage les cœurs entre leurs processus, et la session du
+# livre en a plusieurs (noyaux, visiteurs et Chromium, XeLaTeX). (En priorité basse, celle du paquet ne
+# recevait presque rien pendant les tests du navigateur et finissait seule, 150 s après l'autre, sur un cœur.)
+.venv/bin/python -m pytest -m "not ($BOOK_MARKS)" || package=$?
 book=0
 wait "$book_pid" || book=$?
 trap - INT TERM

@@ -109,10 +109,12 @@ def jupyter_book_command(out: Path, *args: str) -> list[str]:
 
 
 def site_build_command(out: Path) -> list[str]:
-    """Les carnets absents du cache exécutés en parallèle (scripts/execute_notebooks.py), puis la
-    construction du site (``--all``), qui les trouve tous dans le cache."""
+    """Les carnets absents du cache exécutés en parallèle (scripts/execute_notebooks.py), puis (les paquets
+    Debian installés : scripts/wait_system.sh) la construction du site (``--all``), qui les trouve tous dans
+    le cache."""
     execute = [sys.executable, str(ROOT / "scripts" / "execute_notebooks.py"), str(out / "_build" / ".jupyter_cache")]
-    return ["bash", "-c", shlex.join(execute) + " && " + shlex.join(jupyter_book_command(out, "--all"))]
+    wait = ["bash", str(ROOT / "scripts" / "wait_system.sh")]  # Chromium (diagrammes Mermaid) installé
+    return ["bash", "-c", " && ".join(shlex.join(c) for c in (execute, wait, jupyter_book_command(out, "--all")))]
 
 
 class BackgroundBuild:
@@ -203,7 +205,17 @@ def pytest_collection_modifyitems(session, config, items):
         items[:] = rest + [item for _, _, item in sorted(staged, key=lambda t: t[:2])]
 
 
+def wait_for_system() -> None:
+    """Attend les paquets Debian (Chromium sans écran, TeX Live) que scripts/test.sh fait installer en
+    arrière-plan pendant l'exécution des carnets (``KALMAN_SYSTEM_SETUP`` : scripts/wait_system.sh)."""
+    if os.environ.get("KALMAN_SYSTEM_SETUP"):
+        done = subprocess.run(["bash", str(ROOT / "scripts" / "wait_system.sh")], capture_output=True, text=True)
+        if done.returncode != 0:
+            pytest.fail(done.stderr)
+
+
 def tex_missing() -> list[str]:
+    wait_for_system()
     return [tool for tool in TEX_TOOLS if shutil.which(tool) is None]
 
 

@@ -41,6 +41,7 @@ import playwright.sync_api as playwright_api
 import pytest
 
 import kalman_course.interactive as ki
+from conftest import wait_for_system
 from kalman_course.typography import french_spacing
 from kalman_course.numbers import format_spec
 from kalman_course.interactive.static import MARKER, PLOTTED_SOURCE
@@ -108,6 +109,7 @@ def site(request):
     ``KALMAN_BUILT_SITE`` (dossier html : pour relancer ces tests sans reconstruire)."""
     wanted = os.environ.get("KALMAN_BUILT_SITE")
     root = Path(wanted).resolve() if wanted else request.getfixturevalue("built_book")
+    wait_for_system()  # Chromium sans écran
     handler = functools.partial(_QuietHandler, directory=str(root))
     server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
     thread = threading.Thread(target=server.serve_forever, daemon=True)
@@ -119,6 +121,7 @@ def site(request):
 
 @pytest.fixture(scope="module")
 def browser():
+    wait_for_system()
     if not Path(CHROMIUM).exists():
         pytest.fail(f"{CHROMIUM} absent : installez le paquet Debian « chromium-headless-shell » (scripts/setup.sh le fait).")
     with playwright_api.sync_playwright() as p:
