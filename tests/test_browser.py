@@ -53,6 +53,9 @@ CHROMIUM = "/usr/bin/chromium-headless-shell"
 CHROMIUM_ARGS = [
     "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
     "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    # Hors ligne comme l'étudiant : aucun nom d'hôte ne se résout, sauf le serveur local des tests. (Chaque
+    # requête hors du site est en plus notée par open_page : Visit.blocked.)
+    "--host-resolver-rules=MAP * ~NOTFOUND , EXCLUDE 127.0.0.1",
 ]
 # Aucune erreur de page n'est tolérée. (sphinx-thebe, chargée d'office par Jupyter Book 1, insère deux
 # fois son script « const THEBE_JS_URL = … » ; l'extension du livre retire la copie, et
@@ -74,12 +77,9 @@ class GridPoints:
         self.axes, self.time = self.spec.axes, self.spec.time
         self.shape = tuple(axis.values.size for axis in self.axes)
         self.default_index = tuple(axis.default for axis in self.axes)
-        self._runs: dict[tuple[int, ...], dict[str, np.ndarray]] = {}
 
     def run(self, *index: int) -> dict[str, np.ndarray]:
-        if index not in self._runs:
-            self._runs[index] = self.spec.run_at(*index)
-        return self._runs[index]
+        return self.spec.run_at(*index)  # (chaque point calculé une fois par le paquet, puis gardé)
 
 
 #: Figures à curseurs statiques connues (registre du paquet) → leurs points de grille.
@@ -153,26 +153,31 @@ class Visit:
 
 
 def open_page(browser, url: str, allowed_prefix: str, *, viewport=LAPTOP, color_scheme: str = "light",
-              figures: bool = True) -> Visit:
-    """Ouvre ``url`` en bloquant (et notant) toute requête qui ne commence pas par ``allowed_prefix``.
+              figures: bool = True, context=None) -> Visit:
+    """Ouvre ``url`` et note (``Visit.blocked``) toute requête qui ne commence pas par ``allowed_prefix`` ;
+    Chromium n'en envoie aucune hors de la machine (:data:`CHROMIUM_ARGS`).
 
     Après le chargement, ``first_load`` note les adresses chargées (le
     premier chargement) ; puis, si ``figures``, toutes les figures à curseurs de la page sont dessinées
     (elles se chargent d'ordinaire quand elles approchent de l'écran).
+
+    Sans ``context``, la page s'ouvre dans un contexte neuf (fermé avec elle : :func:`close_visit`) ;
+    avec, dans ce contexte, dont le cache HTTP sert les fichiers partagés comme au lecteur qui passe d'un
+    chapitre à l'autre (les réponses du cache comptent dans ``loaded`` comme celles du serveur).
     """
-    context = browser.new_context(viewport=viewport, color_scheme=color_scheme)
+    if context is None:
+        context = browser.new_context(viewport=viewport, color_scheme=color_scheme)
     page = context.new_page()
     visit = Visit(page)
 
-    def route(r):
-        u = r.request.url
-        if u.startswith(allowed_prefix) or u.startswith(("data:", "blob:")):
-            r.continue_()
-        else:
+    def request(r):
+        u = r.url
+        if not (u.startswith(allowed_prefix) or u.startswith(("data:", "blob:"))):
             visit.blocked.append(u)
-            r.abort()
 
-    context.route("**/*", route)
+    # (Pas de « context.route » : l'interception des requêtes par Playwright coupe le cache HTTP et fait
+    # passer chaque requête par Python.)
+    page.on("request", request)
     page.on("pageerror", lambda e: visit.errors.append(str(e)))
     page.on("console", lambda m: visit.console.append(m.text) if m.type == "error" else None)
     page.on("response", lambda r: (visit.broken if r.status >= 400 else visit.loaded).append(r.url))
@@ -182,6 +187,18 @@ def open_page(browser, url: str, allowed_prefix: str, *, viewport=LAPTOP, color_
     if figures:
         load_figures(page)
     return visit
+
+
+def close_visit(visit: Visit, shared_context) -> None:
+    """Ferme la page de la visite, et son contexte s'il lui est propre. Dans un contexte partagé, le
+    stockage de la page (localStorage, sessionStorage : thème, réponses) est vidé pour la page suivante."""
+    if shared_context is None:
+        visit.page.context.close()
+        return
+    try:
+        visit.page.evaluate("() => { localStorage.clear(); sessionStorage.clear(); }")
+    finally:
+        visit.page.close()
 
 
 def load_figures(page) -> None:
@@ -553,6 +570,18 @@ def test_interactive_chapter_works_from_file_url(site, browser):
     page.context.close()
 
 
+def test_requests_outside_the_site_are_noted_and_never_leave_the_machine(site, browser):
+    """La garde hors ligne des visites : une requête vers un autre hôte est notée (``Visit.blocked``) et
+    échoue sans quitter la machine (:data:`CHROMIUM_ARGS`), même quand la page la fait après coup."""
+    visit = open_page(browser, site.base + "search.html", site.base, figures=False)
+    outcome = visit.page.evaluate("""() => fetch('https://cdn.jsdelivr.net/npm/mathjax@3/es5/tex-chtml.js')
+        .then(r => 'chargé ' + r.status, e => 'refusé')""")
+    assert outcome == "refusé"
+    assert visit.blocked == ["https://cdn.jsdelivr.net/npm/mathjax@3/es5/tex-chtml.js"]
+    assert not visit.broken  # une requête refusée n'est pas comptée deux fois
+    close_visit(visit, None)
+
+
 def test_prose_checks_flag_prose_only(browser):
     """Les vérifications du français (sur une page écrite ici) signalent le texte courant fautif et
     laissent le code, les formules, les adresses, les heures et les numéros de version."""
@@ -723,7 +752,7 @@ def _phone_checks(html_file: Path, html: str, toc: set[Path]) -> list[tuple[str,
 
 
 def _visit_page(browser, site: Site, html_file: Path, checks_of: Callable, viewport: dict,
-                color_scheme: str, toc: set[Path]) -> Tour:
+                color_scheme: str, toc: set[Path], context=None) -> Tour:
     """Une page ouverte **une fois** (figures dessinées) ; les vérifications ``checks_of(page)`` s'y
     suivent et notent leurs problèmes à part. Une vérification qui lève une exception (assertion, délai
     de Playwright) compte comme un problème de la page, et les suivantes passent quand même."""
@@ -739,7 +768,8 @@ def _visit_page(browser, site: Site, html_file: Path, checks_of: Callable, viewp
         return tour
     checks = checks_of(html_file, html, toc)
     try:
-        visit = open_page(browser, site.url(html_file), site.base, viewport=viewport, color_scheme=color_scheme)
+        visit = open_page(browser, site.url(html_file), site.base, viewport=viewport, color_scheme=color_scheme,
+                          context=context)
     except playwright_api.Error as exc:
         for key, _ in checks:
             tour.visited[key].append(name)
@@ -751,7 +781,7 @@ def _visit_page(browser, site: Site, html_file: Path, checks_of: Callable, viewp
             check(site, html_file, visit, tour.problems[key], tour.reports[key])
         except (AssertionError, playwright_api.Error) as exc:
             tour.problems[key].append(f"{name} : {type(exc).__name__} : {exc}")
-    visit.page.context.close()
+    close_visit(visit, context)
     return tour
 
 
@@ -782,13 +812,18 @@ def tours(site) -> tuple[Tour, Tour]:
         try:
             with playwright_api.sync_playwright() as p:
                 browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+                # un contexte par visiteur : ses pages partagent le cache HTTP (BokehJS, thème, polices
+                # chargés et compilés une fois) ; ouvrir une page et dessiner ses figures coûte un tiers de
+                # calcul en moins qu'avec un contexte neuf par page
+                context = browser.new_context(viewport=viewport, color_scheme=color_scheme)
                 while True:
                     try:
                         html_file = queues[label].get_nowait()
                     except queue.Empty:
                         break
                     found[label, html_file] = _visit_page(browser, site, html_file, checks_of, viewport,
-                                                          color_scheme, toc)
+                                                          color_scheme, toc, context)
+                context.close()
                 browser.close()
         except BaseException as exc:  # relevée dans le fil principal
             errors.append(exc)

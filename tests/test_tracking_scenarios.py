@@ -147,6 +147,19 @@ def test_simulated_target_flies_the_announced_turns():
     assert np.std(y - truth[:, :2]) == pytest.approx(man.POSITION_STD, rel=0.1)
 
 
+def test_example_trajectory_is_the_first_of_the_study_and_its_filters():
+    """La trajectoire des curseurs (calculée seule) est la première de l'étude de Monte-Carlo, et le filtre
+    calme de l'étude est celui qu'on relance dessus."""
+    st, ex = man.manoeuvre_study(), man.manoeuvre_example()
+    np.testing.assert_array_equal(ex.truth, st.truth)
+    np.testing.assert_array_equal(ex.y, st.y)
+    np.testing.assert_array_equal(ex.t, st.t)
+    np.testing.assert_array_equal(ex.turning, st.turning)
+    assert ex.turning.any() and not ex.turning.all()
+    again = kc.kalman_filter(man.cv_model(man.Q_QUIET), ex.y, man.X0, man.P0)
+    np.testing.assert_array_equal(again.x, st.example["calme"].x)
+
+
 def test_manoeuvre_study_ranks_the_filters():
     st = man.manoeuvre_study()
     i = st.index

@@ -75,6 +75,7 @@ class SliderSpec:
         self.time = as_float_array("time", self.time)
         self.panels = tuple(self.panels)
         self._grid: ParameterGrid | None = None
+        self._runs: dict[tuple[int, ...], dict[str, np.ndarray]] = {}  # exécutions faites par run_at
 
     @property
     def live_hint(self) -> str:
@@ -101,10 +102,19 @@ class SliderSpec:
     def run_at(self, *index: int) -> dict[str, np.ndarray]:
         """L'exécution au point de grille ``index`` : ``grid().run(*index)``, sans calculer toute la grille
         quand elle ne l'est pas encore (``run`` appelé avec les mêmes valeurs que pour la grille ; séries
-        ``float64`` de forme (L,))."""
+        ``float64`` de forme (L,), en lecture seule). Chaque point est calculé une fois, puis gardé, comme
+        la grille (:meth:`text_at` relit la même exécution)."""
         if self._grid is not None:
             return self._grid.run(*index)
-        return {name: np.asarray(values, dtype=float) for name, values in self.run(*self.values_at(*index)).items()}
+        values = self.values_at(*index)  # (vérifie le point)
+        key = tuple(int(i) for i in index)
+        if key in self._runs:
+            return self._runs[key]
+        out = {name: np.array(series, dtype=float) for name, series in self.run(*values).items()}
+        for series in out.values():
+            series.flags.writeable = False
+        self._runs[key] = out
+        return out
 
     def text_at(self, *index: int) -> str:
         """Le texte de lecture au point de grille ``index`` (vide sans ``readout``)."""

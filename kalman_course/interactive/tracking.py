@@ -140,14 +140,14 @@ def fading_axes() -> tuple[ParameterAxis]:
 
 
 def _segments_rms(err: np.ndarray) -> tuple[float, float]:
-    st = man.manoeuvre_study()
+    st = man.manoeuvre_example()
     straight = (st.t > 10.0) & ~st.turning
     return float(np.sqrt(np.mean(err[straight] ** 2))), float(np.sqrt(np.mean(err[st.turning] ** 2)))
 
 
 def fading_run(alpha: float) -> dict[str, np.ndarray]:
     """Le filtre calme avec l'oubli ``alpha`` sur la trajectoire d'exemple : estimation et erreur."""
-    st = man.manoeuvre_study()
+    st = man.manoeuvre_example()
     res = kalman_filter(man.cv_model(man.Q_QUIET), st.y, man.X0, man.P0, fading=None if alpha == 1.0 else alpha)
     err = np.hypot(*(res.x[:, :2] - st.truth[:, :2]).T)
     straight, turn = _segments_rms(err)
@@ -171,7 +171,7 @@ def _plane_glyphs(estimate_legend: str) -> tuple[Glyph, ...]:
 
 
 def _example_fixed() -> dict[str, np.ndarray]:
-    st = man.manoeuvre_study()
+    st = man.manoeuvre_example()
     return {"true_e": st.truth[:, 0] / 1e3, "true_n": st.truth[:, 1] / 1e3, "meas_e": st.y[:, 0] / 1e3,
             "meas_n": st.y[:, 1] / 1e3, "turn": 120.0 * (man.turn_rate_profile(st.t - man.DT) != 0)}
 
@@ -183,7 +183,7 @@ _PLANE = dict(x_label="est (km)", x_range=(-0.3, 3.3), y_range=(-0.3, 3.7), equa
 @register_sliders("manoeuvre-oubli-curseurs", chapter=MANOEUVRE_CHAPTER)
 def fading_spec() -> SliderSpec:
     """Le facteur d'oubli au curseur, sur la cible simulée qui vire."""
-    st = man.manoeuvre_study()
+    st = man.manoeuvre_example()
     return SliderSpec(
         name="manoeuvre-oubli-curseurs",
         chapter=MANOEUVRE_CHAPTER,
@@ -228,7 +228,7 @@ def imm_axes() -> tuple[ParameterAxis, ParameterAxis, ParameterAxis]:
 
 def imm_run(switch: float, q_quiet: float, q_manoeuvre: float) -> dict[str, np.ndarray]:
     """L'IMM sur la trajectoire d'exemple : probabilité du régime agité, erreur et estimation."""
-    st = man.manoeuvre_study()
+    st = man.manoeuvre_example()
     res = imm_filter([man.cv_model(q_quiet), man.cv_model(q_manoeuvre)], st.y, man.X0, man.P0,
                      transition=man.imm_transition(switch), mu0=[1.0 - switch, switch])
     err = np.hypot(*(res.x[:, :2] - st.truth[:, :2]).T)
@@ -247,7 +247,7 @@ def _imm_readout(series, values) -> str:
 @register_sliders("manoeuvre-imm-curseurs", chapter=MANOEUVRE_CHAPTER)
 def imm_spec() -> SliderSpec:
     """L'IMM au curseur : probabilité de changer de régime et densités des deux régimes."""
-    st = man.manoeuvre_study()
+    st = man.manoeuvre_example()
     return SliderSpec(
         name="manoeuvre-imm-curseurs",
         chapter=MANOEUVRE_CHAPTER,

@@ -139,6 +139,39 @@ class ManoeuvreStudy:
         return self.names.index(name)
 
 
+@dataclass(frozen=True, eq=False)
+class ManoeuvreExample:
+    r"""La trajectoire d'exemple : la première des :data:`N_RUNS` trajectoires de :func:`manoeuvre_study`
+    (mêmes tirages). ``t`` (T,) s ; ``turning`` (T,) booléen : un virage et les 10 s qui le suivent ;
+    ``truth`` (T, 4) : :math:`[e, n, v_e, v_n]` vrai (m, m/s) ; ``y`` (T, 2) : relevés radar (m)."""
+
+    t: np.ndarray
+    turning: np.ndarray
+    truth: np.ndarray
+    y: np.ndarray
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "t", "truth", "y")
+        self.turning.flags.writeable = False
+
+
+def _turning(t: np.ndarray) -> np.ndarray:
+    """Pas « en virage » : un virage et les 10 s qui le suivent (le temps de s'en remettre)."""
+    turning = np.zeros(t.shape, dtype=bool)
+    for start, end, _ in TURNS:
+        turning |= (t > start) & (t <= end + 10.0)
+    return turning
+
+
+@lru_cache(maxsize=1)
+def manoeuvre_example() -> ManoeuvreExample:
+    """La trajectoire d'exemple seule (les curseurs du chapitre n'ont pas besoin des :data:`N_RUNS`
+    trajectoires) : le premier tirage de la graine :data:`SEED`, comme dans :func:`manoeuvre_study`."""
+    t = DT * np.arange(1, N_STEPS + 1)
+    truth, y = simulate_target(np.random.default_rng(SEED))
+    return ManoeuvreExample(t=t, turning=_turning(t), truth=truth, y=y)
+
+
 @lru_cache(maxsize=1)
 def manoeuvre_study() -> ManoeuvreStudy:
     """La comparaison des cinq filtres sur :data:`N_RUNS` trajectoires simulées (calculée une fois)."""
@@ -160,10 +193,7 @@ def manoeuvre_study() -> ManoeuvreStudy:
             ne[f] += nees(truth, res)
     rmse = np.sqrt(sq / N_RUNS)
     nees_mean_t = ne / N_RUNS
-    # un virage et les 10 s qui le suivent (le temps de s'en remettre)
-    turning = np.zeros(N_STEPS, dtype=bool)
-    for start, end, _ in TURNS:
-        turning |= (t > start) & (t <= end + 10.0)
+    turning = _turning(t)
     settled = t > 10.0
     straight = settled & ~turning
     rms = lambda mask: np.sqrt(np.mean(rmse[:, mask] ** 2, axis=1))  # noqa: E731
