@@ -91,6 +91,28 @@ fi
 if [ "$want_pdf" = 1 ] && ! tex_ready; then
   apt_packages+=("${TEX_PACKAGES[@]}")
   apt_why+=("TeX Live pour le PDF (XeLaTeX, français)")
+  # En CI seulement (machine jetable, CI=true) : l'installation de TeX Live construit tous ses formats
+  # (fmtutil --all, 50 s de calcul) ; le cours n'utilise que XeLaTeX. Un fmtutil.cnf local (prioritaire)
+  # désactive ceux de LuaLaTeX et les variantes « -dev » : 38 s de calcul en moins. (Sur la machine d'un
+  # étudiant, rien n'est changé ; un format désactivé se construirait au premier usage.)
+  case "${CI:-}" in
+    ""|false|0) ;;
+    *)
+      if [ "$(id -u)" = "0" ] && [ ! -e /etc/texmf/web2c/fmtutil.cnf ]; then
+        mkdir -p /etc/texmf/web2c
+        cat >/etc/texmf/web2c/fmtutil.cnf <<'CNF'
+# Écrit par scripts/setup.sh en CI : formats inutiles au cours, désactivés (« #! »).
+#! dvilualatex luatex language.dat,language.dat.lua dvilualatex.ini
+#! dvilualatex-dev luatex language.dat,language.dat.lua dvilualatex.ini
+#! lualatex luahbtex language.dat,language.dat.lua lualatex.ini
+#! lualatex-dev luahbtex language.dat,language.dat.lua lualatex.ini
+#! latex-dev pdftex language.dat -translate-file=cp227.tcx *latex.ini
+#! pdflatex-dev pdftex language.dat -translate-file=cp227.tcx *pdflatex.ini
+#! xelatex-dev xetex language.dat -etex xelatex.ini
+CNF
+      fi
+      ;;
+  esac
 fi
 if [ "${#apt_packages[@]}" -gt 0 ]; then
   why=${apt_why[0]}${apt_why[1]:+ et ${apt_why[1]}}
