@@ -31,10 +31,16 @@ if [ "$#" -gt 0 ]; then
 fi
 
 BOOK_MARKS="book or browser or pdf"
+# Les grilles des figures à curseurs (27 grilles, ~30 s de calcul) : calculées une fois pour tout le
+# lancement — par les carnets, la session du paquet ou les visites du navigateur, le premier qui en a
+# besoin — et relues par les autres (kalman_course.interactive.figure.GRID_CACHE).
+KALMAN_GRID_CACHE=$(mktemp -d "${TMPDIR:-/tmp}/kalman-grilles.XXXXXX")
+export KALMAN_GRID_CACHE
 book_log=$(mktemp)
-.venv/bin/python -m pytest -m "$BOOK_MARKS" -p no:cacheprovider >"$book_log" 2>&1 &
+.venv/bin/python -m pytest -m "$BOOK_MARKS" -p no:cacheprovider --durations=12 >"$book_log" 2>&1 &
 book_pid=$!
 trap 'kill "$book_pid" 2>/dev/null; true' INT TERM
+trap 'rm -rf "$KALMAN_GRID_CACHE"' EXIT
 package=0
 # Les deux sessions à la même priorité : le système partage les cœurs entre leurs processus, et la session du
 # livre en a plusieurs (noyaux, visiteurs et Chromium, XeLaTeX). (En priorité basse, celle du paquet ne

@@ -67,7 +67,8 @@ APPENDICES = {"references", "errata", "glossaire"}
 
 
 class GridPoints:
-    """Les points de la grille d'une figure à curseurs que la visite relit, calculés ici par le paquet un à
+    """Les points de la grille d'une figure à curseurs que la visite relit : ceux de la grille si elle est
+    déjà calculée dans ce lancement des tests (``KALMAN_GRID_CACHE``), sinon calculés ici par le paquet un à
     un (:meth:`~kalman_course.interactive.figure.SliderSpec.run_at` : les mêmes appels de ``run`` que pour
     la grille, tests/test_slider_grids.py le vérifie) plutôt que la grille entière : axes, abscisse commune,
     position par défaut, ``run(*index)``."""
@@ -79,16 +80,30 @@ class GridPoints:
         self.default_index = tuple(axis.default for axis in self.axes)
 
     def run(self, *index: int) -> dict[str, np.ndarray]:
-        return self.spec.run_at(*index)  # (chaque point calculé une fois par le paquet, puis gardé)
+        # la grille si un processus de ce lancement l'a déjà calculée (les carnets : KALMAN_GRID_CACHE ;
+        # test_a_point_computed_alone_equals_the_grid la compare au calcul seul de chaque point), sinon
+        # le point seul, calculé une fois par le paquet puis gardé
+        grid = self.spec.cached_grid()
+        return grid.run(*index) if grid is not None else self.spec.run_at(*index)
 
 
 #: Figures à curseurs statiques connues (registre du paquet) → leurs points de grille.
 EXPECTED_GRIDS = {name: (lambda name=name: GridPoints(name)) for name in ki.slider_names()}
 
 
+#: Adresse (sur le serveur des tests, hors du site) où la page charge axe-core : un fichier que le cache
+#: HTTP du visiteur garde, compilé une fois, au lieu de 0,5 Mo de source envoyés à chaque visite.
+AXE_PATH = "/__tests__/axe.min.js"
+
+
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):
     def log_message(self, *args):  # pas de journal d'accès dans la sortie des tests
         pass
+
+    def translate_path(self, path):
+        if urlsplit(path).path == AXE_PATH:
+            return str(AXE)
+        return super().translate_path(path)
 
 
 @dataclass
@@ -218,8 +233,9 @@ def figure_ids(page) -> list[str]:
 
 
 def axe_violations(page) -> list[dict]:
-    """Les violations axe-core (WCAG A et AA) de la page : règle, impact, nombre de nœuds, exemples."""
-    page.evaluate(AXE.read_text())
+    """Les violations axe-core (WCAG A et AA) de la page : règle, impact, nombre de nœuds, exemples.
+    (axe-core est chargé du serveur des tests, :data:`AXE_PATH`, après le premier chargement de la page.)"""
+    page.add_script_tag(url=AXE_PATH)
     return page.evaluate(
         """(tags) => axe.run(document, {runOnly: {type: 'tag', values: tags}}).then(r => r.violations.map(v =>
              ({id: v.id, impact: v.impact, nodes: v.nodes.length,

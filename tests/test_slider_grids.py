@@ -133,6 +133,28 @@ def test_a_point_computed_alone_equals_the_grid(name):
         fresh.run_at(*grid.shape)
 
 
+def test_grid_cache_is_written_once_and_read_back_by_another_process(tmp_path, monkeypatch):
+    """Dossier partagé d'un lancement des tests (``KALMAN_GRID_CACHE``) : la grille calculée par une
+    description est écrite, une autre description (un autre processus) la relit sans rien recalculer, et
+    ``cached_grid`` ne calcule jamais."""
+    name = "intuition-produit"
+    monkeypatch.setenv(ki.figure.GRID_CACHE, str(tmp_path / "grilles"))
+    first = ki.figure.SLIDER_FIGURES[name][1]()
+    assert first.cached_grid() is None  # rien de calculé, rien d'écrit
+    computed = first.grid()
+    assert [p.name for p in (tmp_path / "grilles").iterdir()] == [f"{name}.npz"]
+    second = ki.figure.SLIDER_FIGURES[name][1]()
+    second.run = lambda *values: pytest.fail("grille recalculée au lieu d'être relue")
+    read = second.cached_grid()
+    assert read is not None and read.series.keys() == computed.series.keys()
+    for series, values in computed.series.items():
+        np.testing.assert_array_equal(read.series[series], values)
+        assert not read.series[series].flags.writeable
+    assert read.run(*read.default_index).keys() == computed.run(*computed.default_index).keys()
+    monkeypatch.delenv(ki.figure.GRID_CACHE)
+    assert ki.figure.SLIDER_FIGURES[name][1]().cached_grid() is None  # sans le dossier : rien n'est lu
+
+
 # --------------------------------------------------------------------------- introduction et intuition
 
 

@@ -19,7 +19,9 @@ donne les curseurs interactifs.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
@@ -83,9 +85,23 @@ class SliderSpec:
         return f'kc.interactive.live_explorer("{self.name}")'
 
     def grid(self) -> ParameterGrid:
-        """Toutes les exécutions de la grille (calculées une fois, puis gardées : elles sont immuables)."""
+        """Toutes les exécutions de la grille (calculées une fois, puis gardées : elles sont immuables).
+
+        Avec la variable d'environnement :data:`GRID_CACHE` (un dossier neuf, créé par scripts/test.sh pour
+        un lancement des tests), la grille calculée par un processus y est écrite et les autres la relisent :
+        carnets, session du paquet et visites du navigateur la calculent une fois en tout."""
         if self._grid is None:
-            self._grid = precompute_grid(self.run, *self.axes, time=self.time)
+            folder = os.environ.get(GRID_CACHE)
+            self._grid = (precompute_grid(self.run, *self.axes, time=self.time) if not folder
+                          else _shared_grid(self, Path(folder)))
+        return self._grid
+
+    def cached_grid(self) -> ParameterGrid | None:
+        """La grille si elle est déjà calculée, dans ce processus ou dans le dossier :data:`GRID_CACHE` ;
+        sinon ``None`` (rien n'est calculé)."""
+        folder = os.environ.get(GRID_CACHE)
+        if self._grid is None and folder and (Path(folder) / f"{self.name}.npz").is_file():
+            return self.grid()
         return self._grid
 
     def values_at(self, *index: int) -> tuple[float, ...]:
@@ -174,6 +190,30 @@ class SliderSpec:
             fixed=dict(self.fixed),
             readout=readout,
         )
+
+
+#: Variable d'environnement : dossier où les processus d'un même lancement des tests partagent les grilles.
+GRID_CACHE = "KALMAN_GRID_CACHE"
+
+
+def _shared_grid(spec: SliderSpec, folder: Path) -> ParameterGrid:
+    """La grille de ``spec`` lue dans ``folder`` (``NOM.npz`` : une série par nom), ou calculée puis écrite
+    (fichier temporaire renommé : un lecteur ne voit jamais un fichier à moitié écrit)."""
+    path = folder / f"{spec.name}.npz"
+    if path.is_file():
+        with np.load(path) as data:
+            series = {name: data[name] for name in data.files}
+        shape = tuple(axis.values.size for axis in spec.axes)
+        if all(values.shape[:-1] == shape for values in series.values()):
+            for values in series.values():
+                values.flags.writeable = False
+            return ParameterGrid(axes=spec.axes, time=spec.time, series=series)
+    grid = precompute_grid(spec.run, *spec.axes, time=spec.time)
+    folder.mkdir(parents=True, exist_ok=True)
+    partial = folder / f".{spec.name}.{os.getpid()}.npz"
+    np.savez(partial, **grid.series)
+    os.replace(partial, path)
+    return grid
 
 
 #: Le registre : nom → (chapitre, fonction qui construit la description).
