@@ -87,7 +87,9 @@ from pdf import TARGET  # noqa: E402
 BUILD_REPORT: list[str] = []
 _EXECUTED = re.compile(r"Executing notebook using|^\[carnets\] book/.*: \d", re.M)
 _FROM_CACHE = re.compile(r"Using cached notebook")
-_READING = re.compile(r"^(?:\x1b\[[0-9;]*m)*reading sources\.\.\.", re.M)  # (couleurs ANSI de Sphinx)
+#: Une page relue : « reading sources... [ 3%] page » (couleurs ANSI de Sphinx) ; la ligne seule, sans page,
+#: dit qu'aucune ne l'est.
+_READING = re.compile(r"^(?:\x1b\[[0-9;]*m)*reading sources\.\.\. *(?:\x1b\[[0-9;]*m)*\[ *\d+%\]", re.M)
 #: Outils du PDF (TeX Live et poppler-utils).
 TEX_TOOLS = ("xelatex", "latexmk", "pdftotext", "pdfinfo", "pdfimages")
 #: Étapes des tests qui lisent le livre, dans l'ordre où ils passent.

@@ -17,6 +17,7 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -130,18 +131,21 @@ def test_math_of_every_chapter_is_typeset(pdf_build):
         assert re.search(r"\\\(|\\begin\{(equation|align|split)", chunk), f"{name} : aucune formule"
 
 
-def test_every_figure_is_an_image_that_is_not_empty(pdf_build, tmp_path):
+def test_every_figure_is_an_image_that_is_not_empty(pdf_build):
     draws = sum(len(re.findall(r"kc\.figures\.draw\(", (ROOT / f"{d}.md").read_text())) for d in _toc_docs())
     sliders = _slider_figures()
     listing = subprocess.run(["pdfimages", "-list", str(pdf_build["pdf"])], check=True, capture_output=True,
                              text=True).stdout.splitlines()[2:]
     numbers = [int(line.split()[1]) for line in listing if line.split()[2] == "image"]  # pas les masques
     assert len(numbers) >= draws + sliders, f"{len(numbers)} images pour {draws} figures et {sliders} à curseurs"
-    subprocess.run(["pdfimages", "-png", str(pdf_build["pdf"]), str(tmp_path / "img")], check=True)
-    for path in (tmp_path / f"img-{number:03d}.png" for number in numbers):
-        pixels = np.asarray(Image.open(path).convert("L"), dtype=float)
-        assert min(pixels.shape) >= 100, f"{path.name} : image minuscule {pixels.shape}"
-        assert pixels.std() > 5.0, f"{path.name} : image uniforme (figure vide)"
+    # images brutes (PPM, sans compression : trois fois moins de calcul que -png), effacées aussitôt lues
+    with tempfile.TemporaryDirectory() as folder:
+        subprocess.run(["pdfimages", str(pdf_build["pdf"]), f"{folder}/img"], check=True)
+        for number in numbers:
+            (path,) = Path(folder).glob(f"img-{number:03d}.p[bgp]m")
+            pixels = np.asarray(Image.open(path).convert("L"), dtype=float)
+            assert min(pixels.shape) >= 100, f"{path.name} : image minuscule {pixels.shape}"
+            assert pixels.std() > 5.0, f"{path.name} : image uniforme (figure vide)"
 
 
 def test_static_slider_figures_are_printed_with_their_caption(pdf_build):
