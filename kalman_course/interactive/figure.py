@@ -26,6 +26,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from ..core.results import freeze
 from ..core.validation import KalmanInputError, as_float_array
 from .grid import ParameterAxis, ParameterGrid, precompute_grid
 from .spec import Panel
@@ -126,11 +127,8 @@ class SliderSpec:
         key = tuple(int(i) for i in index)
         if key in self._runs:
             return self._runs[key]
-        out = {name: np.array(series, dtype=float) for name, series in self.run(*values).items()}
-        for series in out.values():
-            series.flags.writeable = False
-        self._runs[key] = out
-        return out
+        self._runs[key] = {name: freeze(series) for name, series in self.run(*values).items()}
+        return self._runs[key]
 
     def text_at(self, *index: int) -> str:
         """Le texte de lecture au point de grille ``index`` (vide sans ``readout``)."""
@@ -202,11 +200,9 @@ def _shared_grid(spec: SliderSpec, folder: Path) -> ParameterGrid:
     path = folder / f"{spec.name}.npz"
     if path.is_file():
         with np.load(path) as data:
-            series = {name: data[name] for name in data.files}
+            series = {name: freeze(data[name]) for name in data.files}
         shape = tuple(axis.values.size for axis in spec.axes)
         if all(values.shape[:-1] == shape for values in series.values()):
-            for values in series.values():
-                values.flags.writeable = False
             return ParameterGrid(axes=spec.axes, time=spec.time, series=series)
     grid = precompute_grid(spec.run, *spec.axes, time=spec.time)
     folder.mkdir(parents=True, exist_ok=True)

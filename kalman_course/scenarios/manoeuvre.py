@@ -178,7 +178,8 @@ def manoeuvre_study() -> ManoeuvreStudy:
     import scipy.stats
 
     rng = np.random.default_rng(SEED)
-    t = DT * np.arange(1, N_STEPS + 1)
+    ex = manoeuvre_example()  # la première trajectoire, ses instants et ses virages
+    t, turning = ex.t, ex.turning
     sq = np.zeros((len(FILTERS), N_STEPS))
     ne = np.zeros((len(FILTERS), N_STEPS))
     example = truth0 = y0 = None
@@ -193,7 +194,6 @@ def manoeuvre_study() -> ManoeuvreStudy:
             ne[f] += nees(truth, res)
     rmse = np.sqrt(sq / N_RUNS)
     nees_mean_t = ne / N_RUNS
-    turning = _turning(t)
     settled = t > 10.0
     straight = settled & ~turning
     rms = lambda mask: np.sqrt(np.mean(rmse[:, mask] ** 2, axis=1))  # noqa: E731
