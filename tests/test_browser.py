@@ -234,10 +234,12 @@ def figure_ids(page) -> list[str]:
 
 def axe_violations(page) -> list[dict]:
     """Les violations axe-core (WCAG A et AA) de la page : règle, impact, nombre de nœuds, exemples.
-    (axe-core est chargé du serveur des tests, :data:`AXE_PATH`, après le premier chargement de la page.)"""
+    (axe-core est chargé du serveur des tests, :data:`AXE_PATH`, après le premier chargement de la page.
+    ``resultTypes`` : les nœuds conformes ne sont pas décrits un à un — les violations restent toutes.)"""
     page.add_script_tag(url=AXE_PATH)
     return page.evaluate(
-        """(tags) => axe.run(document, {runOnly: {type: 'tag', values: tags}}).then(r => r.violations.map(v =>
+        """(tags) => axe.run(document, {runOnly: {type: 'tag', values: tags}, resultTypes: ['violations']})
+             .then(r => r.violations.map(v =>
              ({id: v.id, impact: v.impact, nodes: v.nodes.length,
                examples: v.nodes.slice(0, 3).map(n => n.target.join(' ') + ' : ' + n.html.slice(0, 120))})))""",
         AXE_TAGS)
