@@ -16,12 +16,9 @@ désigne un dossier qui les contient, sinon calculées (leur calcul compte alors
 from __future__ import annotations
 
 import argparse
-import functools
-import http.server
 import os
 import re
 import sys
-import threading
 from collections import Counter
 from pathlib import Path
 
@@ -96,8 +93,8 @@ def axe_rules(site: tb.Site, name: str) -> tuple[dict, list[tuple[float, str]]]:
         dom = page.evaluate("""() => ({all: document.getElementsByTagName('*').length,
             math: document.querySelectorAll('mjx-container, mjx-container *').length})""")
         page.add_script_tag(url=tb.AXE_PATH)
-        page.evaluate("""(tags) => axe.run(document, {runOnly: {type: 'tag', values: tags},
-            resultTypes: ['violations'], performanceTimer: true}).then(() => true)""", tb.AXE_TAGS)
+        page.evaluate("(options) => axe.run(document, options).then(() => true)",
+                      {**tb.AXE_OPTIONS, "performanceTimer": True})
         browser.close()
     rules = [(float(m[2]), m[1]) for m in (re.match(r"Measure rule_([\w-]+) took ([\d.]+)ms", t) for t in messages) if m]
     return dom, sorted(rules, reverse=True)
@@ -113,26 +110,23 @@ def main(argv: list[str] | None = None) -> None:
     if missing:
         parser.error(f"page(s) introuvable(s) dans {root / 'book'} : {', '.join(missing)} (construisez le site : "
                      "bash scripts/build.sh)")
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(tb._QuietHandler, directory=str(root)))
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    site = tb.Site(root, f"http://127.0.0.1:{server.server_address[1]}/")
-    start = busy()
-    costs = visit_costs(site, args.pages)
-    total = busy() - start
+    with tb.served(root) as site:
+        start = busy()
+        costs = visit_costs(site, args.pages)
+        total = busy() - start
+        heaviest = max(args.pages, key=lambda n: (root / "book" / f"{n}.html").stat().st_size)
+        dom, rules = axe_rules(site, heaviest)
     print(f"Visites de {len(args.pages)} page(s) sur deux écrans : {format_spec(total, '.1f')} s de calcul "
           f"({format_spec(total / (2 * len(args.pages)), '.1f')} s par visite)")
     for label, cost in costs.items():
         print(f"  {label} :")
         for step, seconds in cost.most_common():
             print(f"    {step:30s} {format_spec(seconds, '.1f'):>6s} s  {format_spec(100 * seconds / total, '.0f'):>3s} %")
-    heaviest = max(args.pages, key=lambda n: (root / "book" / f"{n}.html").stat().st_size)
-    dom, rules = axe_rules(site, heaviest)
     print(f"\naxe-core sur {heaviest} (portable) : {format_spec(dom['all'], 'd')} éléments, dont "
           f"{format_spec(dom['math'], 'd')} dans les formules ({format_spec(100 * dom['math'] / dom['all'], '.0f')} %) ; "
           f"{format_spec(sum(ms for ms, _ in rules) / 1000, '.1f')} s de règles, les plus coûteuses :")
     for ms, rule in rules[:6]:
         print(f"    {rule:30s} {format_spec(ms / 1000, '.2f'):>6s} s")
-    server.shutdown()
 
 
 if __name__ == "__main__":

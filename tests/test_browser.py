@@ -24,6 +24,7 @@ visible, et chaque image a une légende et un texte de remplacement.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import http.server
 import os
@@ -118,6 +119,19 @@ class Site:
         return self.root / urlsplit(url).path.lstrip("/")
 
 
+@contextlib.contextmanager
+def served(root: Path):
+    """Le site du dossier ``root`` servi en local le temps du bloc (axe-core compris, :data:`AXE_PATH`)."""
+    handler = functools.partial(_QuietHandler, directory=str(root))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        yield Site(root, f"http://127.0.0.1:{server.server_address[1]}/")
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
 @pytest.fixture(scope="module")
 def site(request):
     """Le site construit par la session (``built_book``), ou un site déjà construit désigné par
@@ -125,13 +139,8 @@ def site(request):
     wanted = os.environ.get("KALMAN_BUILT_SITE")
     root = Path(wanted).resolve() if wanted else request.getfixturevalue("built_book")
     wait_for_system()  # Chromium sans écran
-    handler = functools.partial(_QuietHandler, directory=str(root))
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    yield Site(root, f"http://127.0.0.1:{server.server_address[1]}/")
-    server.shutdown()
-    server.server_close()
+    with served(root) as built:
+        yield built
 
 
 @pytest.fixture(scope="module")
@@ -152,6 +161,9 @@ PHONE = {"width": 390, "height": 844}
 AXE = ROOT / "node_modules" / "axe-core" / "axe.min.js"
 #: Règles d'axe-core exigées : WCAG 2.0 et 2.1, niveaux A et AA (le RGAA).
 AXE_TAGS = ["wcag2a", "wcag2aa", "wcag21a", "wcag21aa"]
+#: Options d'``axe.run`` : ces règles ; les nœuds conformes ne sont pas décrits un à un (``resultTypes``),
+#: les violations restent toutes.
+AXE_OPTIONS = {"runOnly": {"type": "tag", "values": AXE_TAGS}, "resultTypes": ["violations"]}
 #: Poids maximal d'une page au premier chargement (octets des fichiers servis).
 FIRST_LOAD_LIMIT = 2.5e6
 
@@ -234,15 +246,14 @@ def figure_ids(page) -> list[str]:
 
 def axe_violations(page) -> list[dict]:
     """Les violations axe-core (WCAG A et AA) de la page : règle, impact, nombre de nœuds, exemples.
-    (axe-core est chargé du serveur des tests, :data:`AXE_PATH`, après le premier chargement de la page.
-    ``resultTypes`` : les nœuds conformes ne sont pas décrits un à un — les violations restent toutes.)"""
+    (axe-core est chargé du serveur des tests, :data:`AXE_PATH`, après le premier chargement de la page ;
+    options : :data:`AXE_OPTIONS`.)"""
     page.add_script_tag(url=AXE_PATH)
     return page.evaluate(
-        """(tags) => axe.run(document, {runOnly: {type: 'tag', values: tags}, resultTypes: ['violations']})
-             .then(r => r.violations.map(v =>
+        """(options) => axe.run(document, options).then(r => r.violations.map(v =>
              ({id: v.id, impact: v.impact, nodes: v.nodes.length,
                examples: v.nodes.slice(0, 3).map(n => n.target.join(' ') + ' : ' + n.html.slice(0, 120))})))""",
-        AXE_TAGS)
+        AXE_OPTIONS)
 
 
 def serious(violations: list[dict]) -> list[dict]:
