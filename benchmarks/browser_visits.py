@@ -81,8 +81,9 @@ def visit_costs(site: tb.Site, pages: list[str]) -> dict[str, Counter]:
 
 
 def axe_rules(site: tb.Site, name: str) -> tuple[dict, list[tuple[float, str]]]:
-    """Pour la page ``name`` (portable) : éléments du DOM (dont formules) et durée (ms) de chaque règle
-    d'axe-core dans une exécution complète."""
+    """Pour la page ``name`` (portable) : éléments du DOM (dont formules, et rendus de formules remplacés
+    par des boîtes comme dans les tests) et durée (ms) de chaque règle d'axe-core dans une exécution
+    complète."""
     messages: list[str] = []
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=tb.CHROMIUM, args=tb.CHROMIUM_ARGS)
@@ -93,6 +94,7 @@ def axe_rules(site: tb.Site, name: str) -> tuple[dict, list[tuple[float, str]]]:
         dom = page.evaluate("""() => ({all: document.getElementsByTagName('*').length,
             math: document.querySelectorAll('mjx-container, mjx-container *').length})""")
         page.add_script_tag(url=tb.AXE_PATH)
+        dom["boxed"] = page.evaluate(tb.BOX_FORMULAS)["boxed"]  # comme les tests (tb.axe_violations)
         page.evaluate("(options) => axe.run(document, options).then(() => true)",
                       {**tb.AXE_OPTIONS, "performanceTimer": True})
         browser.close()
@@ -123,7 +125,8 @@ def main(argv: list[str] | None = None) -> None:
         for step, seconds in cost.most_common():
             print(f"    {step:30s} {format_spec(seconds, '.1f'):>6s} s  {format_spec(100 * seconds / total, '.0f'):>3s} %")
     print(f"\naxe-core sur {heaviest} (portable) : {format_spec(dom['all'], 'd')} éléments, dont "
-          f"{format_spec(dom['math'], 'd')} dans les formules ({format_spec(100 * dom['math'] / dom['all'], '.0f')} %) ; "
+          f"{format_spec(dom['math'], 'd')} dans les formules ({format_spec(100 * dom['math'] / dom['all'], '.0f')} %), "
+          f"{format_spec(dom['boxed'], 'd')} rendus de formules en boîtes le temps d'axe-core ; "
           f"{format_spec(sum(ms for ms, _ in rules) / 1000, '.1f')} s de règles, les plus coûteuses :")
     for ms, rule in rules[:6]:
         print(f"    {rule:30s} {format_spec(ms / 1000, '.2f'):>6s} s")

@@ -244,16 +244,83 @@ def figure_ids(page) -> list[str]:
     return page.evaluate("() => [...document.querySelectorAll('.kc-bokeh-root')].map(r => r.id)")
 
 
+#: Le temps d'axe-core, le rendu CHTML de chaque formule (``mjx-math``, caché aux lecteurs d'écran par
+#: ``aria-hidden``, ses glyphes dessinés en CSS, sans nœud de texte) est remplacé par une boîte vide de même
+#: taille et de même ligne de base, puis remis. axe-core n'y trouve rien à vérifier, mais y passait le
+#: cinquième de son calcul (38 pages, deux écrans : 217 s de calcul, 170 avec les boîtes, et les mêmes
+#: violations, mineures comprises, nœud par nœud). Seuls les rendus
+#: faits d'éléments ``mjx-*`` sans texte, sans attribut d'accessibilité ou de focus (``aria-*``, ``role``,
+#: ``tabindex``, ``href``, ``id``…) et sans style de couleur, de fond, de bordure ou ``!important`` sont
+#: remplacés : tout autre rendu reste tel quel devant axe-core. Le MathML d'assistance (ce que lit un
+#: lecteur d'écran) et l'élément ``mjx-math`` lui-même restent. La mise en page ne bouge pas
+#: (test_formula_boxes_keep_the_layout_and_come_back).
+BOX_FORMULAS = r"""() => {
+  const unsafeAttr = /^(aria-|role$|tabindex$|href$|id$|title$|alt$|lang$|contenteditable$|on)/i;
+  const unsafeStyle = /!important|color|background|border|outline/i;
+  const safe = m => {
+    const walker = document.createTreeWalker(m, NodeFilter.SHOW_ELEMENT | NodeFilter.SHOW_TEXT);
+    for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+      if (n.nodeType === Node.TEXT_NODE) { if (n.data.trim()) return false; continue; }
+      if (!n.localName.startsWith('mjx-')) return false;
+      for (const a of n.attributes) {
+        if (unsafeAttr.test(a.name) || (a.name === 'style' && unsafeStyle.test(a.value))) return false;
+      }
+    }
+    return true;
+  };
+  const all = [...document.querySelectorAll('mjx-container > mjx-math')];
+  const maths = all.filter(safe);
+  // une sonde vide par formule donne la ligne de base ; toutes les lectures, puis toutes les écritures
+  const probes = maths.map(m => {
+    const p = document.createElement('span');
+    p.style.cssText = 'display:inline-block;width:0;height:0;vertical-align:baseline';
+    m.before(p);
+    return p;
+  });
+  const boxes = maths.map((m, i) => [m.getBoundingClientRect(), probes[i].getBoundingClientRect().bottom]);
+  window.__kcBoxed = maths.map((m, i) => {
+    const [r, baseline] = boxes[i];
+    probes[i].remove();
+    const content = document.createDocumentFragment();
+    content.append(...m.childNodes);
+    const style = m.getAttribute('style');
+    // (par l'attribut : le style écrit par m.style reviendrait en « style="" » après removeAttribute)
+    m.setAttribute('style', (style ? style + ';' : '') + `display:inline-block;width:${r.width}px;` +
+                            `height:${r.height}px;vertical-align:${baseline - r.bottom}px`);
+    return [m, content, style];
+  });
+  return {boxed: maths.length, kept: all.length - maths.length};
+}"""
+#: Remet chaque rendu CHTML à sa place (:data:`BOX_FORMULAS`).
+UNBOX_FORMULAS = r"""() => {
+  for (const [m, content, style] of window.__kcBoxed || []) {
+    m.append(content);
+    if (style === null) m.removeAttribute('style'); else m.setAttribute('style', style);
+  }
+  delete window.__kcBoxed;
+}"""
+
+
 def axe_violations(page) -> list[dict]:
     """Les violations axe-core (WCAG A et AA) de la page : règle, impact, nombre de nœuds, exemples.
     (axe-core est chargé du serveur des tests, :data:`AXE_PATH`, après le premier chargement de la page ;
-    options : :data:`AXE_OPTIONS`.)"""
+    options : :data:`AXE_OPTIONS` ; rendus CHTML des formules en boîtes le temps du calcul :
+    :data:`BOX_FORMULAS`.)"""
     page.add_script_tag(url=AXE_PATH)
-    return page.evaluate(
-        """(options) => axe.run(document, options).then(r => r.violations.map(v =>
-             ({id: v.id, impact: v.impact, nodes: v.nodes.length,
-               examples: v.nodes.slice(0, 3).map(n => n.target.join(' ') + ' : ' + n.html.slice(0, 120))})))""",
-        AXE_OPTIONS)
+    count = "() => document.getElementsByTagName('*').length"
+    before = page.evaluate(count)
+    page.evaluate(BOX_FORMULAS)
+    try:
+        violations = page.evaluate(
+            """(options) => axe.run(document, options).then(r => r.violations.map(v =>
+                 ({id: v.id, impact: v.impact, nodes: v.nodes.length,
+                   examples: v.nodes.slice(0, 3).map(n => n.target.join(' ') + ' : ' + n.html.slice(0, 120))})))""",
+            AXE_OPTIONS)
+    finally:
+        page.evaluate(UNBOX_FORMULAS)
+    after = page.evaluate(count)
+    assert after == before, f"formules mal remises après axe-core : {before} éléments avant, {after} après"
+    return violations
 
 
 def serious(violations: list[dict]) -> list[dict]:
@@ -1057,6 +1124,42 @@ def test_keyboard_reaches_the_first_slider_in_a_few_keys(site, browser, capsys):
         print(f"\nClavier (introduction) : premier curseur atteint en {plain} tabulations depuis le haut de la "
               f"page (dont {links} liens), ou en 4 touches par le lien d'évitement (Tab, Tab, Entrée, Tab)")
     assert plain <= 200, "premier curseur jamais atteint au clavier"
+
+
+_LAYOUT = """() => [...document.querySelectorAll(
+    'main p, main li, main h2, main h3, main td, main a, main img, mjx-container, mjx-math')].map(e => {
+    const r = e.getBoundingClientRect();
+    return [r.left, r.top, r.width, r.height].map(v => Math.round(v * 4) / 4); })"""
+
+
+def test_formula_boxes_keep_the_layout_and_come_back(site, browser):
+    """Les boîtes qui remplacent les rendus CHTML le temps d'axe-core (:data:`BOX_FORMULAS`) : toutes les
+    formules d'une page de formules deviennent des boîtes, la mise en page ne bouge pas (au quart de pixel
+    près), la page revient à l'identique ; un rendu qui porte du texte ou un attribut de focus reste."""
+    visit = open_page(browser, site.base + "book/estimateur.html", site.base, figures=False)
+    page = visit.page
+    # deux rendus que axe-core doit voir : du texte, un élément que le clavier atteint
+    page.evaluate("""() => {
+      const maths = document.querySelectorAll('mjx-container > mjx-math');
+      maths[0].querySelector('mjx-c').append('x');
+      maths[1].querySelector('mjx-c').setAttribute('tabindex', '0');
+    }""")
+    html = page.evaluate("() => document.querySelector('main').innerHTML")
+    layout, n = page.evaluate(_LAYOUT), page.locator("mjx-container > mjx-math").count()
+    elements = "() => document.getElementsByTagName('*').length"
+    count = page.evaluate(elements)
+    inside = page.evaluate("""() => [...document.querySelectorAll('mjx-container > mjx-math')].slice(2)
+        .reduce((total, m) => total + m.getElementsByTagName('*').length, 0)""")
+    assert n > 100
+    report = page.evaluate(BOX_FORMULAS)
+    assert report == {"boxed": n - 2, "kept": 2}
+    assert page.evaluate(_LAYOUT) == layout
+    assert page.evaluate(elements) == count - inside  # le rendu de chaque boîte, hors du document
+    assert page.locator("mjx-math mjx-c").count() > 0  # les deux rendus gardés
+    page.evaluate(UNBOX_FORMULAS)
+    assert page.evaluate("() => document.querySelector('main').innerHTML") == html
+    assert page.evaluate(_LAYOUT) == layout
+    close_visit(visit, None)
 
 
 def test_diagrams_and_quiz_answers_have_text_alternatives(site, browser):
