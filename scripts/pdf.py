@@ -49,9 +49,12 @@ def compile_pdf(latex_dir: Path, output: Path | None = None) -> tuple[Path, floa
             raise PdfError(f"« {tool} » introuvable : installez TeX Live avec « bash scripts/setup.sh --pdf ».")
     start = time.perf_counter()
     # latexmkrc écrit par Sphinx (dans latex_dir) : XeLaTeX et ses options ; -pdfxe le confirme.
+    # xdvipdfmx compresse les images du PDF au niveau 6 de zlib (celui de zlib par défaut) au lieu de 9 :
+    # 7 s de calcul au lieu de 18 pour les 94 figures (PNG avec transparence, recompressées), un PDF plus
+    # gros de 3 % ; la compression reste sans perte.
     proc = subprocess.run(
         ["latexmk", "-pdfxe", "-dvi-", "-ps-", "-interaction=nonstopmode", "-halt-on-error", "-file-line-error",
-         f"{TARGET}.tex"],
+         "-e", "$xdvipdfmx = q/xdvipdfmx -z 6 -E -o %D %O %S/", f"{TARGET}.tex"],
         cwd=latex_dir, capture_output=True, text=True, errors="replace", stdin=subprocess.DEVNULL,
     )
     elapsed = time.perf_counter() - start
