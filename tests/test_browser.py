@@ -248,12 +248,11 @@ def figure_ids(page) -> list[str]:
 #: ``aria-hidden``, ses glyphes dessinés en CSS, sans nœud de texte) est remplacé par une boîte vide de même
 #: taille et de même ligne de base, puis remis. axe-core n'y trouve rien à vérifier, mais y passait le
 #: cinquième de son calcul (38 pages, deux écrans : 217 s de calcul, 170 avec les boîtes, et les mêmes
-#: violations, mineures comprises, nœud par nœud). Seuls les rendus
-#: faits d'éléments ``mjx-*`` sans texte, sans attribut d'accessibilité ou de focus (``aria-*``, ``role``,
-#: ``tabindex``, ``href``, ``id``…) et sans style de couleur, de fond, de bordure ou ``!important`` sont
-#: remplacés : tout autre rendu reste tel quel devant axe-core. Le MathML d'assistance (ce que lit un
-#: lecteur d'écran) et l'élément ``mjx-math`` lui-même restent. La mise en page ne bouge pas
-#: (test_formula_boxes_keep_the_layout_and_come_back).
+#: violations, mineures comprises, nœud par nœud). Seuls les rendus faits d'éléments ``mjx-*`` sans texte,
+#: sans attribut d'accessibilité ou de focus (``aria-*``, ``role``, ``tabindex``, ``href``, ``id``…) et
+#: sans style de couleur, de fond, de bordure ou ``!important`` sont remplacés : tout autre rendu reste tel
+#: quel devant axe-core. Le MathML d'assistance (ce que lit un lecteur d'écran) et l'élément ``mjx-math``
+#: lui-même restent. La mise en page ne bouge pas (test_formula_boxes_keep_the_layout_and_come_back).
 BOX_FORMULAS = r"""() => {
   const unsafeAttr = /^(aria-|role$|tabindex$|href$|id$|title$|alt$|lang$|contenteditable$|on)/i;
   const unsafeStyle = /!important|color|background|border|outline/i;
@@ -299,6 +298,8 @@ UNBOX_FORMULAS = r"""() => {
   }
   delete window.__kcBoxed;
 }"""
+#: Nombre d'éléments du document (la page revient-elle entière après :data:`UNBOX_FORMULAS` ?).
+ELEMENT_COUNT = "() => document.getElementsByTagName('*').length"
 
 
 def axe_violations(page) -> list[dict]:
@@ -307,8 +308,7 @@ def axe_violations(page) -> list[dict]:
     options : :data:`AXE_OPTIONS` ; rendus CHTML des formules en boîtes le temps du calcul :
     :data:`BOX_FORMULAS`.)"""
     page.add_script_tag(url=AXE_PATH)
-    count = "() => document.getElementsByTagName('*').length"
-    before = page.evaluate(count)
+    before = page.evaluate(ELEMENT_COUNT)
     page.evaluate(BOX_FORMULAS)
     try:
         violations = page.evaluate(
@@ -318,7 +318,7 @@ def axe_violations(page) -> list[dict]:
             AXE_OPTIONS)
     finally:
         page.evaluate(UNBOX_FORMULAS)
-    after = page.evaluate(count)
+    after = page.evaluate(ELEMENT_COUNT)
     assert after == before, f"formules mal remises après axe-core : {before} éléments avant, {after} après"
     return violations
 
@@ -1146,15 +1146,14 @@ def test_formula_boxes_keep_the_layout_and_come_back(site, browser):
     }""")
     html = page.evaluate("() => document.querySelector('main').innerHTML")
     layout, n = page.evaluate(_LAYOUT), page.locator("mjx-container > mjx-math").count()
-    elements = "() => document.getElementsByTagName('*').length"
-    count = page.evaluate(elements)
+    count = page.evaluate(ELEMENT_COUNT)
     inside = page.evaluate("""() => [...document.querySelectorAll('mjx-container > mjx-math')].slice(2)
         .reduce((total, m) => total + m.getElementsByTagName('*').length, 0)""")
     assert n > 100
     report = page.evaluate(BOX_FORMULAS)
     assert report == {"boxed": n - 2, "kept": 2}
     assert page.evaluate(_LAYOUT) == layout
-    assert page.evaluate(elements) == count - inside  # le rendu de chaque boîte, hors du document
+    assert page.evaluate(ELEMENT_COUNT) == count - inside  # le rendu de chaque boîte, hors du document
     assert page.locator("mjx-math mjx-c").count() > 0  # les deux rendus gardés
     page.evaluate(UNBOX_FORMULAS)
     assert page.evaluate("() => document.querySelector('main').innerHTML") == html
