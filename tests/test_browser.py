@@ -1161,6 +1161,38 @@ def test_formula_boxes_keep_the_layout_and_come_back(site, browser):
     close_visit(visit, None)
 
 
+def test_dragging_a_slider_leaves_the_page_style(site, browser):
+    """Glisser un curseur ne recalcule pas le style de toute la page : noUiSlider (dans BokehJS) écrit
+    « cursor » et « user-select » dans le style de body pendant le glissé, mais body garde son style calculé
+    (règle de kc/kc-pages.css ; sans elle, deux recalculs du style du document à chaque glissé, ≈ 150 ms
+    chacun sur un chapitre à curseurs). Le glissé déplace bien le curseur, et le texte de la page n'est pas
+    sélectionné quand la souris y passe."""
+    visit = open_page(browser, site.base + "book/tension-constante.html", site.base)
+    page = visit.page
+    handle = page.locator(f"[{MARKER}] .noUi-handle").first
+    base = page.locator(f"[{MARKER}] .noUi-base").first
+    handle.focus()  # comme les vérifications des curseurs : le clavier d'abord, puis la souris
+    page.keyboard.press("End")
+    computed = "() => { const s = getComputedStyle(document.body); return [s.cursor, s.userSelect]; }"
+    before, end = page.evaluate(computed), handle.get_attribute("aria-valuenow")
+    hb, bb = handle.bounding_box(), base.bounding_box()
+    y = hb["y"] + hb["height"] / 2
+    page.mouse.move(hb["x"] + hb["width"] / 2, y)
+    page.mouse.down()
+    page.mouse.move(bb["x"] + 0.3 * bb["width"], y, steps=4)
+    written = page.evaluate("() => document.body.getAttribute('style') || ''")
+    during = page.evaluate(computed)
+    page.mouse.move(bb["x"] + 0.3 * bb["width"], max(y - 200, 5), steps=4)  # au-dessus du curseur : le texte
+    selected = page.evaluate("() => window.getSelection().toString()")
+    page.mouse.up()
+    assert "cursor" in written, f"noUiSlider n'a rien écrit dans le style de body ({written!r}) : test à revoir"
+    assert during == before == ["auto", "auto"], f"style de body pendant le glissé : {during} (avant : {before})"
+    assert selected == "", f"texte sélectionné pendant le glissé : {selected[:80]!r}"
+    assert handle.get_attribute("aria-valuenow") != end, "le glissé n'a pas déplacé le curseur"
+    assert not visit.errors, visit.errors
+    close_visit(visit, None)
+
+
 def test_diagrams_and_quiz_answers_have_text_alternatives(site, browser):
     """Les diagrammes ont un texte de remplacement (les textes de leurs boîtes) ; chaque réponse de quiz
     a un nom accessible lisible, formules écrites en texte."""
