@@ -8,7 +8,10 @@
    contentful paint ») servi par un serveur local, objectif < 1 s.
 3. Réponse des curseurs dans Chromium headless : de l'événement clavier réel (touche flèche sur la
    poignée) à la recopie des données (rappel CustomJS), puis à la fin du rendu des panneaux par BokehJS
-   (fin du dernier requestAnimationFrame qu'il a demandé) ; objectif < 50 ms.
+   (fin du dernier requestAnimationFrame qu'il a demandé) ; objectif < 50 ms. Puis le glissé à la souris :
+   travail du fil principal de la page à l'appui sur la poignée et au relâchement (métriques de Chromium :
+   tâches, dont recalcul des styles), objectif < 50 ms chacun (avant la règle de kc-pages.css sur body,
+   ≈ 200 ms sur un chapitre à curseurs : tout le style de la page recalculé).
 
 Usage : python benchmarks/interactive.py [--site _build/html] [--moves 40] [--only grilles,poids,réponse]
 """
@@ -204,6 +207,26 @@ def bench_weights(browser, root: Path, base: str) -> None:
               f"(objectif < 1 000 ms : {'atteint' if slow < 1000 else 'MANQUÉ'})")
 
 
+def press_cost(page, cdp, handle) -> tuple[float, float, float, float]:
+    """Travail du fil principal de la page (ms : tâches, dont recalcul des styles) à l'appui de la souris sur
+    ``handle``, puis au relâchement (300 ms laissées à chacun pour finir son rendu)."""
+    def metrics():
+        values = {m["name"]: m["value"] for m in cdp.send("Performance.getMetrics")["metrics"]}
+        return values["TaskDuration"], values["RecalcStyleDuration"]
+
+    box = handle.bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.wait_for_timeout(300)
+    costs = []
+    for action in (page.mouse.down, page.mouse.up):
+        before = metrics()
+        action()
+        page.wait_for_timeout(300)
+        after = metrics()
+        costs += [1000 * (after[0] - before[0]), 1000 * (after[1] - before[1])]
+    return tuple(costs)
+
+
 def bench_response(browser, root: Path, base: str, moves: int) -> None:
     print(f"\n3. Réponse des curseurs dans Chromium headless "
           f"({format_spec(moves, 'd')} déplacements au clavier par curseur)")
@@ -213,6 +236,8 @@ def bench_response(browser, root: Path, base: str, moves: int) -> None:
             continue
         page, _, _ = open_page(browser, base + rel, base)
         load_figures(page)
+        cdp = page.context.new_cdp_session(page)
+        cdp.send("Performance.enable")
         figures = page.locator(f"[{MARKER}]")
         ids = page.evaluate("() => [...document.querySelectorAll('.kc-bokeh-root')].map(r => r.id)")
         for k in range(figures.count()):
@@ -257,6 +282,11 @@ def bench_response(browser, root: Path, base: str, moves: int) -> None:
                       f"     figure redessinée : médiane {format_spec(med, '.1f'):>5s} ms, "
                       f"{ninety} {format_spec(p90, '.1f'):>5s} ms, max {format_spec(worst, '.1f'):>5s} ms"
                       f" — objectif < 50 ms : {verdict}")
+                down, down_style, up, up_style = press_cost(page, cdp, handle)
+                print(f"     glissé à la souris : appui {format_spec(down, '.0f')} ms (styles "
+                      f"{format_spec(down_style, '.0f')} ms), relâchement {format_spec(up, '.0f')} ms (styles "
+                      f"{format_spec(up_style, '.0f')} ms) de travail du fil principal — objectif < 50 ms : "
+                      f"{'atteint' if max(down, up) < 50 else 'MANQUÉ'}")
         page.close()
 
 
