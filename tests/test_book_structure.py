@@ -549,3 +549,68 @@ def test_errata_entries_say_what_checks_them_in_words_then_name_the_test():
     assert len(entries) >= 70
     problems = [f"{entry.split(chr(10), 2)[1][:40]} : {p}" for entry in entries for p in verified_by_problems(entry)]
     assert not problems, "\n".join(problems)
+
+
+# --------------------------------------------------------------------------- relecture (issue 36)
+
+_CELL = re.compile(r"^```\{code-cell\}[^\n]*\n(.*?)^```", re.S | re.M)
+
+
+def _cells(text: str) -> list[tuple[bool, str]]:
+    """Les cellules de code d'une page MyST : ``(cachée, code)`` (``remove-cell`` ou ``remove-input``)."""
+    out = []
+    for cell in _CELL.findall(text):
+        tags = re.search(r"^:tags:\s*\[([^\]]*)\]", cell, re.M)
+        hidden = bool(tags and {"remove-cell", "remove-input"} & {t.strip() for t in tags.group(1).split(",")})
+        body = re.sub(r"\A---\n.*?\n---\n", "", cell, flags=re.S)
+        out.append((hidden, "\n".join(line for line in body.splitlines() if not line.startswith(":tags:"))))
+    return out
+
+
+def hidden_definitions_used_in_visible_cells(text: str) -> list[str]:
+    """Les noms qu'une cellule **cachée** définit (fonction, classe, variable ; pas une importation, que la
+    page montre dans « Importations du chapitre ») et qu'une cellule **visible** emploie sans les définir :
+    l'étudiant qui recopie les cellules visibles obtiendrait une ``NameError``."""
+    import ast
+
+    def names(tree, kinds):
+        out = set()
+        for node in ast.walk(tree):
+            if "def" in kinds and isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+                out.add(node.name)
+            elif "def" in kinds and isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+                out.add(node.id)
+            elif "import" in kinds and isinstance(node, (ast.Import, ast.ImportFrom)):
+                out |= {(a.asname or a.name).split(".")[0] for a in node.names}
+        return out
+
+    hidden_defs, visible_defs, problems = set(), set(), []
+    for hidden, code in _cells(text):
+        try:
+            tree = ast.parse(code)
+        except SyntaxError:  # une cellule magique d'IPython : rien à lire
+            continue
+        if hidden:
+            hidden_defs |= names(tree, {"def"}) - names(tree, {"import"})
+            continue
+        own = names(tree, {"def", "import"})
+        loads = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+        problems += sorted((loads & hidden_defs) - visible_defs - own - set(problems))
+        visible_defs |= own
+    return problems
+
+
+def test_hidden_definition_check():
+    hidden = "```{code-cell} ipython3\n:tags: [remove-cell]\nimport numpy as np\n\ndef exact(v):\n    return v\n```\n"
+    bad = hidden + "\n```{code-cell} ipython3\nprint(exact(np.ones(2)))\n```\n"
+    assert hidden_definitions_used_in_visible_cells(bad) == ["exact"]
+    good = hidden + "\n```{code-cell} ipython3\ndef exact(v):\n    return 2 * v\nprint(exact(np.ones(2)))\n```\n"
+    assert hidden_definitions_used_in_visible_cells(good) == []
+
+
+@pytest.mark.parametrize("page", TOC)
+def test_visible_cells_run_when_copied(page):
+    """td-lissage-em appelait ``exact()``, définie dans une cellule cachée : les cellules visibles n'emploient
+    que des noms qu'elles définissent ou que la page importe (bloc « Importations du chapitre »)."""
+    problems = hidden_definitions_used_in_visible_cells(_text(page))
+    assert not problems, f"{page} : noms définis dans une cellule cachée : {problems}"

@@ -504,6 +504,12 @@ def test_tutorial_one_answers_are_the_package_values():
     assert r"$P = (1 - 0{,}8) \times 4 = 0{,}8$ °C²" in text
     assert step.K[0, 0] == pytest.approx(0.8, abs=1e-14) and step.S[0, 0] == pytest.approx(5.0)
     assert step.x[0] == pytest.approx(22.4, abs=1e-12) and step.P[0, 0] == pytest.approx(0.8, abs=1e-14)
+    # les rapports cités : la mesure est quatre fois plus précise que l'a priori (4 / 1), la variance a
+    # posteriori cinq fois plus petite que celle de l'a priori (4 / 0,8) — et non « quatre fois plus sûre »
+    c = kc.scenarios.tutorials.THERMOMETER
+    assert "quatre fois plus précise que l'a priori" in text and "cinq\nfois plus petite" in text
+    assert c["P_prior"] / c["R"] == pytest.approx(4.0) and c["P_prior"] / step.P[0, 0] == pytest.approx(5.0)
+    assert "quatre fois plus sûre" not in text
 
 
 def test_tutorial_two_answers_are_the_package_values():

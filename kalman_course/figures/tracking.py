@@ -141,7 +141,7 @@ def two_sensors():
         err = np.hypot(*(np.asarray(track.y)[rows, :2] - res.x_pred[rows, :2]).T)
         rms = heli.prediction_rms(res, track)
         ax.plot(np.asarray(track.t)[rows], err, color=color, lw=1.0,
-                label=f"{label} (moyenne quadratique {fr(rms, '.1f')} m)")
+                label=f"{label} (REQM {fr(rms, '.1f')} m)")
     ax.set_yscale("log")
     ax.set_xlabel("temps (s)")
     ax.set_ylabel("|position mesurée − prédite| (m)")
@@ -205,7 +205,7 @@ def _shade_turns(ax, label=True) -> None:
 
 
 @register("manoeuvre-retard", chapter=MANOEUVRE_CHAPTER,
-          title="Un filtre réglé pour la ligne droite décroche dans le virage ; réglé pour virer, il tremble")
+          title="Un filtre réglé pour la ligne droite décroche dans le virage ; réglé pour virer, il suit le bruit des relevés")
 def lag_figure():
     st = man.manoeuvre_study()
     truth, y, ex = st.truth, st.y, st.example
@@ -226,8 +226,8 @@ def lag_figure():
         ax.plot(st.t, st.rmse[i], color=FILTER_COLORS[name], lw=1.5, label=f"filtre {name}")
     ax.set_yscale("log")
     ax.set_xlabel("temps (s)")
-    ax.set_ylabel("erreur quadratique moyenne de position (m)")
-    ax.set_title(f"Moyenne sur {man.N_RUNS} trajectoires")
+    ax.set_ylabel("REQM de position (m)")
+    ax.set_title(f"Racine de l'erreur quadratique moyenne sur {man.N_RUNS} trajectoires", fontsize=9)
     ax.legend(loc="upper left", fontsize=8)
     _grid(ax)
     return fig
@@ -243,8 +243,8 @@ def comparison_figure():
     for name in st.names:
         ax.plot(st.t, st.rmse[st.index(name)], color=FILTER_COLORS[name], lw=1.4, label=name)
     ax.set_yscale("log")
-    ax.set_ylabel("erreur de position (m)")
-    ax.set_title(f"Erreur quadratique moyenne sur {man.N_RUNS} trajectoires")
+    ax.set_ylabel("REQM de position (m)")
+    ax.set_title(f"Racine de l'erreur quadratique moyenne (REQM) sur {man.N_RUNS} trajectoires")
     ax.legend(loc="upper left", fontsize=8, ncol=3)
     _grid(ax)
     ax = axes[1]
@@ -256,7 +256,7 @@ def comparison_figure():
     ax.axhline(4.0, color="0.3", lw=0.8, ls="--", label="n = 4")
     ax.set_yscale("log")
     ax.set_xlabel("temps (s)")
-    ax.set_ylabel("NEES moyen (sans unité)")
+    ax.set_ylabel("NEES moyenne (sans unité)")
     ax.set_title("Cohérence : l'erreur est-elle celle que P annonce ?")
     ax.legend(loc="upper left", fontsize=8)
     _grid(ax)

@@ -513,10 +513,11 @@ class StaticSliders:
         hint = f" (<code>{html.escape(self.live_hint)}</code>)" if self.live_hint else ""
         # Message visible seulement si BokehJS manque (carnet ouvert dans Jupyter, par exemple) :
         # dans le livre, le script l'efface avant d'insérer la figure.
-        missing = (
+        # (HTML brut : l'extension de typographie du livre ne le voit pas, d'où french_spacing ici)
+        missing = french_spacing(
             "Figure à curseurs précalculés : elle s’affiche dans le livre publié, qui sert BokehJS. "
-            f"Dans Jupyter, utilisez les curseurs interactifs{hint}."
-        )
+            "Dans Jupyter, utilisez les curseurs interactifs"
+        ) + f"{hint}."
         title = italic_latin_html(html.escape(french_spacing(self.title or f"Figure à curseurs « {self.name} »")))
         texts = getattr(self, "_texts", [])
         default = int(np.ravel_multi_index(self.grid.default_index, self.grid.shape))

@@ -20,6 +20,7 @@ from ..filters.imm import imm_filter
 from ..filters.kalman import kalman_filter
 from ..scenarios import helicopter as heli
 from ..scenarios import manoeuvre as man
+from ..numbers import format_number
 from .figure import SliderSpec, ellipse_outline, number, register_sliders
 from .grid import ParameterAxis
 from .spec import Follow, Glyph, Panel
@@ -55,7 +56,8 @@ def gate_axes() -> tuple[ParameterAxis, ParameterAxis]:
     q_fit = heli.fitted_parameters("position")[0]
     return (
         ParameterAxis("gate", "p", "probabilité de la porte", "", np.array(GATES), default=2, scale="index",
-                      tick_labels=tuple(number(g, significant=5) for g in GATES[:-1]) + ("sans porte",)),
+                      tick_labels=tuple(format_number(g, significant=5, trim=True) for g in GATES[:-1])
+                      + ("sans fenêtre",)),
         ParameterAxis("q", "q", "densité d'accélération", "m²/s³", q_fit * np.array(Q_FACTORS),
                       default=Q_FACTORS.index(1.0)),
     )
@@ -89,7 +91,7 @@ def _gate_readout(series, values) -> str:
     lost = series["lost"][0]
     where = "jamais perdue" if np.isnan(lost) else f"perdue à t = {number(lost, 's')}"
     return (f"Positions rejetées : {int(series['n_rejected'][0])} sur 278, dont {int(series['n_outliers'][0])} "
-            f"des 6 aberrantes ; erreur de prédiction (moyenne quadratique) : {number(series['rms'][0], 'm')} ; "
+            f"des 6 aberrantes ; REQM de prédiction des positions : {number(series['rms'][0], 'm')} ; "
             f"piste {where}.")
 
 
@@ -158,7 +160,7 @@ def fading_run(alpha: float) -> dict[str, np.ndarray]:
 
 def _fading_readout(series, values) -> str:
     straight, turn = series["rms"]
-    return (f"Erreur quadratique moyenne de position : {number(straight, 'm')} en ligne droite, "
+    return (f"REQM de position : {number(straight, 'm')} en ligne droite, "
             f"{number(turn, 'm')} dans les virages (et les 10 s qui suivent).")
 
 
@@ -170,10 +172,14 @@ def _plane_glyphs(estimate_legend: str) -> tuple[Glyph, ...]:
     )
 
 
+#: Hauteur (m) des surfaces « virages » : bien au-delà de l'axe, elles le couvrent en entier (tracé ``clip``).
+TURN_BAND = 1e5
+
+
 def _example_fixed() -> dict[str, np.ndarray]:
     st = man.manoeuvre_example()
     return {"true_e": st.truth[:, 0] / 1e3, "true_n": st.truth[:, 1] / 1e3, "meas_e": st.y[:, 0] / 1e3,
-            "meas_n": st.y[:, 1] / 1e3, "turn": 120.0 * (man.turn_rate_profile(st.t - man.DT) != 0)}
+            "meas_n": st.y[:, 1] / 1e3, "turn": TURN_BAND * (man.turn_rate_profile(st.t - man.DT) != 0)}
 
 
 _PLANE = dict(x_label="est (km)", x_range=(-0.3, 3.3), y_range=(-0.3, 3.7), equal_aspect=True, width=400,
@@ -195,7 +201,7 @@ def fading_spec() -> SliderSpec:
         panels=(
             Panel("Dans le plan", "nord (km)", _plane_glyphs("estimation avec oubli"), **_PLANE),
             Panel("Erreur de position et son 2σ annoncé", "erreur (m)", (
-                Glyph("turn", "area", "gray", "virages", alpha=0.6),
+                Glyph("turn", "area", "gray", "virages", alpha=0.35, clip=True),  # toute la hauteur
                 Glyph("sd", "line", "royalblue", "2σ annoncé", dash="dashed", width=1.5),
                 Glyph("err", "line", "darkorange", "erreur de position", width=1.6),
             ), y_log=False, y_range=Follow(include=(0.0,)), height=230),  # sans oubli, l'erreur passe 120 m
@@ -239,7 +245,7 @@ def imm_run(switch: float, q_quiet: float, q_manoeuvre: float) -> dict[str, np.n
 
 def _imm_readout(series, values) -> str:
     straight, turn = series["rms"]
-    return (f"Erreur quadratique moyenne de position : {number(straight, 'm')} en ligne droite, "
+    return (f"REQM de position : {number(straight, 'm')} en ligne droite, "
             f"{number(turn, 'm')} dans les virages ; probabilité moyenne du régime agité "
             f"{number(float(np.mean(series['mu'])), significant=2)}.")
 
