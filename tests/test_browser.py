@@ -985,7 +985,8 @@ _PHONE = r"""() => {
                cut: [], values: []};
   const column = document.querySelector('main .bd-article, main article, main');
   const width = column ? column.getBoundingClientRect().width : window.innerWidth;
-  for (const el of document.querySelectorAll('main .kc-bokeh-panel, main .kc-bokeh-slider, main img, main object')) {
+  // (le canevas de Bokeh aussi : un plan de largeur fixe dépassait de sa boîte, coupé par la colonne)
+  for (const el of document.querySelectorAll('main .kc-bokeh-panel, main .kc-bokeh-canvas > *, main .kc-bokeh-slider, main img, main object')) {
     const b = el.getBoundingClientRect();
     if (b.width > 0 && (b.right > window.innerWidth + 1 || b.left < -1)) out.wide.push(el.id || el.tagName);
   }

@@ -1203,6 +1203,11 @@ def _gaussian_large_uncertainty():
     (x0, x1), (y0, y1) = _static("gaussien-banane-regles").ranges_at(0, *position("gaussien-banane-regles",
                                                                                     bearing_std=60.0))
     assert x0 <= run["lin_x"].min() and run["lin_x"].max() <= x1 and y0 <= run["gh_y"].min()  # tout est visible
+    # le nuage gris est celui de 60° (issue 36) : sa moyenne est la vraie, à l'erreur de Monte-Carlo près
+    cloud = np.column_stack([run["cloud_x"], run["cloud_y"]])
+    assert np.all(np.abs(cloud.mean(axis=0) - [run["truth_mx"][0], run["truth_my"][0]])
+                  < 4 * cloud.std(axis=0) / np.sqrt(len(cloud)))
+    assert np.ptp(run["cloud_x"]) > 1.5  # il fait plus du demi-cercle (r = 1 m)
 
 
 @promise("filtre-gaussien", 1, 2)

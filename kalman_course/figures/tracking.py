@@ -53,10 +53,21 @@ def helicopter_flight():
     ax.plot(f.east / 1e3, f.north / 1e3, ".", color="tab:blue", ms=3, label="positions", zorder=3)
     ax.plot(0, 0, "s", color="black", ms=7, label="première position", zorder=4)
     ax.plot(f.east[-1] / 1e3, f.north[-1] / 1e3, "^", color="black", ms=8, label="dernière position", zorder=4)
+    track_km = np.column_stack([f.east, f.north]) / 1e3
+    placed: list[np.ndarray] = []
     for minute in range(1, int(f.duration // 60) + 1):  # repères de temps le long du vol
         k = int(np.searchsorted(f.t, 60.0 * minute))
-        ax.annotate(f"{minute} min", (f.east[k] / 1e3, f.north[k] / 1e3), xytext=(6, 0),
-                    textcoords="offset points", fontsize=8, color="0.25")
+        # étiquette à 0,45 km du repère, dans la direction (parmi huit) la plus loin de la trajectoire et
+        # des étiquettes déjà posées : l'aller et le retour passent au même endroit (1 et 4 min)
+        angles = np.deg2rad(np.arange(0, 360, 45))
+        spots = track_km[k] + 0.45 * np.column_stack([np.cos(angles), np.sin(angles)])
+        obstacles = np.vstack([track_km] + [np.repeat(q[None], 40, axis=0) for q in placed])
+        clearance = [np.min(np.hypot(*(obstacles - spot).T)) for spot in spots]
+        spot = spots[int(np.argmax(clearance))]
+        placed.append(spot)
+        ax.annotate(f"{minute} min", track_km[k], xytext=tuple(spot), textcoords="data", fontsize=8,
+                    color="0.2", ha="center", va="center",
+                    arrowprops=dict(arrowstyle="-", color="0.5", lw=0.6, shrinkA=0, shrinkB=3))
         ax.plot(f.east[k] / 1e3, f.north[k] / 1e3, "o", color="0.25", ms=4, zorder=4)
     ax.set_title(f"{len(f)} positions ADS-B en {fr(f.duration / 60, '.1f')} min")
     ax.legend(loc="upper right", fontsize=8)

@@ -55,7 +55,7 @@ def gate_axes() -> tuple[ParameterAxis, ParameterAxis]:
     """La porte :math:`p` (0,9 à 0,9999, ou aucune) et la densité :math:`q` (0,01 à 10 fois l'apprise)."""
     q_fit = heli.fitted_parameters("position")[0]
     return (
-        ParameterAxis("gate", "p", "probabilité de la porte", "", np.array(GATES), default=2, scale="index",
+        ParameterAxis("gate", "p", "fenêtre de validation", "", np.array(GATES), default=2, scale="index",
                       tick_labels=tuple(format_number(g, significant=5, trim=True) for g in GATES[:-1])
                       + ("sans fenêtre",)),
         ParameterAxis("q", "q", "densité d'accélération", "m²/s³", q_fit * np.array(Q_FACTORS),
@@ -95,31 +95,43 @@ def _gate_readout(series, values) -> str:
             f"piste {where}.")
 
 
+#: Agrandissement : les deux positions aberrantes consécutives (lignes 80 et 81 de :data:`~.helicopter.OUTLIER_ROWS`),
+#: à ± ``ZOOM_HALF_WIDTH`` km en est.
+ZOOM_ROWS, ZOOM_HALF_WIDTH = (1, 2), 0.35
+
+
 @register_sliders("capteurs-porte-curseurs", chapter=SENSORS_CHAPTER)
 def gate_spec() -> SliderSpec:
-    """La porte et la densité, au curseur, sur l'hélicoptère aux six positions corrompues."""
+    """La fenêtre de validation et la densité, au curseur, sur l'hélicoptère aux six positions corrompues ;
+    un agrandissement montre le crochet de l'estimation vers deux positions aberrantes consécutives."""
     track = heli.helicopter_track("position")
     y = heli.with_outliers(track)
     bad = np.flatnonzero(track.position_rows)[list(heli.OUTLIER_ROWS)]
     e, n = np.asarray(track.y)[:, 0] / 1e3, np.asarray(track.y)[:, 1] / 1e3
+    zoom = np.asarray(track.y)[bad[list(ZOOM_ROWS)], :2].mean(axis=0) / 1e3
+    plane = lambda clip: (  # noqa: E731 — les tracés du plan, coupés par le cadre de l'agrandissement
+        Glyph("meas_n", "scatter", "gray", "positions mesurées", x="meas_e", marker="cross", size=5, clip=clip),
+        Glyph("out_n", "scatter", "crimson", "positions aberrantes", x="out_e", marker="x", size=11, clip=clip),
+        Glyph("ell_n", "line", "royalblue", "ellipses à 2σ", x="ell_e", width=1.0, alpha=0.7, clip=clip),
+        Glyph("est_n", "line", "darkorange", "estimation", x="est_e", width=1.8, clip=clip),
+        Glyph("rej_n", "scatter", "black", "positions rejetées", x="rej_e", marker="circle", size=7, clip=clip),
+    )
     return SliderSpec(
         name="capteurs-porte-curseurs",
         chapter=SENSORS_CHAPTER,
-        title="Hélicoptère SAMU 31, six positions corrompues : porte p et densité q du filtre",
+        title="Hélicoptère SAMU 31, six positions corrompues : fenêtre de validation p et densité q du filtre",
         x_label="temps (s)",
         axes=gate_axes(),
         run=gate_run,
         time=np.asarray(track.t),
         panels=(
-            Panel("Estimation, ellipses à 2σ (une sur six)", "nord (km)", (
-                Glyph("meas_n", "scatter", "gray", "positions mesurées", x="meas_e", marker="cross", size=5),
-                Glyph("out_n", "scatter", "crimson", "positions aberrantes", x="out_e", marker="x", size=11),
-                Glyph("ell_n", "line", "royalblue", "ellipses à 2σ", x="ell_e", width=1.0, alpha=0.7),
-                Glyph("est_n", "line", "darkorange", "estimation", x="est_e", width=1.8),
-                Glyph("rej_n", "scatter", "black", "positions rejetées", x="rej_e", marker="circle", size=7),
-            ), x_label="est (km)", x_range=(-1.5, 5.5), y_range=Follow(aspect=7.0 / 7.8, margin=0.04),
-                equal_aspect=True, width=400, height=370),  # une piste perdue part loin : le plan la suit
-            Panel("NIS de chaque position et seuil de la porte", "NIS (sans unité)", (
+            Panel("Estimation, ellipses à 2σ (une sur six)", "nord (km)", plane(False),
+                  x_label="est (km)", x_range=(-1.5, 5.5), y_range=Follow(aspect=7.0 / 7.8, margin=0.04),
+                  equal_aspect=True, width=400, height=370),  # une piste perdue part loin : le plan la suit
+            Panel("Agrandissement : deux positions aberrantes consécutives", "nord (km)", plane(True),
+                  x_label="est (km)", x_range=(zoom[0] - ZOOM_HALF_WIDTH, zoom[0] + ZOOM_HALF_WIDTH),
+                  y_range=(zoom[1] - 0.3, zoom[1] + 0.3), equal_aspect=True, width=400, height=340),
+            Panel("NIS de chaque position et seuil de la fenêtre", "NIS (sans unité)", (
                 Glyph("nis", "scatter", "darkorange", "NIS", marker="dot", size=6),
                 Glyph("threshold", "line", "black", "seuil χ²₂(p)", dash="dashed", width=1.5),
             ), y_log=True, y_range=(1e-4, 1e6), height=220),
@@ -201,7 +213,7 @@ def fading_spec() -> SliderSpec:
         panels=(
             Panel("Dans le plan", "nord (km)", _plane_glyphs("estimation avec oubli"), **_PLANE),
             Panel("Erreur de position et son 2σ annoncé", "erreur (m)", (
-                Glyph("turn", "area", "gray", "virages", alpha=0.35, clip=True),  # toute la hauteur
+                Glyph("turn", "area", "gray", "virages", alpha=0.6, clip=True),  # toute la hauteur
                 Glyph("sd", "line", "royalblue", "2σ annoncé", dash="dashed", width=1.5),
                 Glyph("err", "line", "darkorange", "erreur de position", width=1.6),
             ), y_log=False, y_range=Follow(include=(0.0,)), height=230),  # sans oubli, l'erreur passe 120 m
