@@ -5,6 +5,7 @@ la main)."""
 from __future__ import annotations
 
 import inspect
+import re
 from pathlib import Path
 
 import pybtex.plugin
@@ -170,3 +171,62 @@ def test_a_formula_mathjax_refuses_names_its_page(tmp_path, mathjax_settings):
     _, problems = typeset_pages([page], **mathjax_settings)
     assert problems == ["td.html : « \\hatx + 1 » : commande inconnue \\hatx",
                         "td.html : « \\frac{1}{ » : Missing close brace"]
+
+
+# --------------------------------------------------------------------------- sphinx-proof en français (issue 36)
+
+_PROOF_PAGE = """# Chapitre
+
+```{prf:algorithm} Un pas du filtre
+:label: alg-pas
+
+1. Prédire.
+2. Corriger.
+```
+
+```{prf:proof}
+:class: dropdown
+
+Par **Fubini**, les deux intégrales sont égales.
+```
+"""
+
+
+def _sphinx_project(tmp_path: Path, builder: str) -> tuple[int, Path, str]:
+    import contextlib
+    import io
+
+    from sphinx.cmd.build import build_main
+
+    src = tmp_path / f"src-{builder}"
+    src.mkdir()
+    (src / "conf.py").write_text('extensions = ["myst_parser", "sphinx_proof", "kalman_course.sphinx.proofs"]\n'
+                                 'myst_enable_extensions = ["colon_fence", "dollarmath"]\nlanguage = "fr"\n'
+                                 'root_doc = "index"\nnumfig = True\n')
+    (src / "index.md").write_text(_PROOF_PAGE)
+    out, log = tmp_path / f"out-{builder}", io.StringIO()
+    with contextlib.redirect_stderr(log):
+        code = build_main(["-b", builder, "-q", "-W", "-E", str(src), str(out)])
+    return code, out, log.getvalue()
+
+
+def test_proofs_get_a_french_title_and_fold(tmp_path):
+    """« Proof. » (sphinx-proof) devient un encadré titré « Démonstration », replié avec ``:class: dropdown``
+    (le titre sert de bouton à sphinx-togglebutton)."""
+    code, out, log = _sphinx_project(tmp_path, "html")
+    assert code == 0, log
+    html = (out / "index.html").read_text()
+    assert "Proof." not in html
+    box = re.search(r'<div class="([^"]*)" id="([^"]+)">\s*<p class="admonition-title">Démonstration</p>', html)
+    assert box and {"proof", "dropdown", "admonition"} <= set(box.group(1).split()), html
+    assert box.group(2) != "proof"  # un identifiant par encadré (sphinx-proof donnait « proof » à toutes)
+    assert "Par <strong>Fubini</strong>, les deux" in html
+
+
+def test_algorithm_boxes_are_titled_in_french_in_the_pdf(tmp_path):
+    """Dans le LaTeX (le PDF), les encadrés d'algorithme sont titrés « Algorithme », comme sur le site."""
+    code, out, log = _sphinx_project(tmp_path, "latex")
+    assert code == 0, log
+    tex = next(out.glob("*.tex")).read_text()
+    assert "Algorithm " not in tex.replace("\\begin{algorithm", "") and "Algorithme" in tex
+    assert "Proof." not in tex and "Démonstration" in tex

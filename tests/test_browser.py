@@ -727,6 +727,21 @@ def _check_chapter_sliders(site: Site, html_file: Path, visit: Visit, problems: 
         problems.append(f"{html_file.relative_to(site.root).as_posix()} : aucune figure à curseurs")
 
 
+#: Contraste WCAG entre la couleur du texte d'un élément et son fond (calculés par le navigateur).
+_CONTRAST = r"""(el) => {
+  const rgb = (c) => (c.match(/[\d.]+/g) || []).slice(0, 4).map(Number);
+  const lum = ([r, g, b]) => {
+    const f = (v) => { v /= 255; return v <= 0.03928 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4); };
+    return 0.2126 * f(r) + 0.7152 * f(g) + 0.0722 * f(b);
+  };
+  const style = getComputedStyle(el);
+  let bg = rgb(style.backgroundColor);
+  for (let p = el.parentElement; p && (bg.length === 4 && bg[3] === 0); p = p.parentElement) bg = rgb(getComputedStyle(p).backgroundColor);
+  const a = lum(rgb(style.color)), b = lum(bg);
+  return (Math.max(a, b) + 0.05) / (Math.min(a, b) + 0.05);
+}"""
+
+
 def _check_quiz(site: Site, html_file: Path, visit: Visit, problems: list[str], report: list[str]) -> None:
     """Chaque question du quiz de la page : une mauvaise réponse est marquée fausse, la bonne juste,
     l'explication se déplie ; aucune requête pendant le quiz."""
@@ -752,9 +767,22 @@ def _check_quiz(site: Site, html_file: Path, visit: Visit, problems: list[str], 
             question.locator(".kc-quiz-check").click()
             return question.get_attribute("class").split(), question.locator(".kc-quiz-feedback").text_content()
 
-        classes, feedback = submit(1 if answer != 1 else 2)
+        wrong = 1 if answer != 1 else 2
+        classes, feedback = submit(wrong)
         if "kc-quiz-wrong" not in classes or not feedback.startswith("Pas tout"):
             problems.append(f"{name} : question {q + 1}, une mauvaise réponse n'est pas marquée fausse")
+        # le message de la mauvaise réponse choisie, et lui seul, est montré (issue 36)
+        shown = question.locator(".kc-quiz-why").evaluate_all(
+            "ws => ws.filter(w => !w.hidden && w.offsetParent !== null).map(w => w.dataset.choice)")
+        if shown != [str(wrong)]:
+            problems.append(f"{name} : question {q + 1}, messages montrés {shown} pour la réponse {wrong}")
+        if q == 0:  # « Vérifier » reste lisible au survol (fond et texte de la même couleur auparavant)
+            button = question.locator(".kc-quiz-check")
+            button.hover()
+            ratio = page.evaluate(_CONTRAST, button.element_handle())
+            if ratio < 4.5:
+                problems.append(f"{name} : « Vérifier » au survol, contraste {ratio:.2f} < 4,5")
+            page.mouse.move(0, 0)
         classes, feedback = submit(answer)
         if "kc-quiz-right" not in classes or not feedback.startswith("Juste"):
             problems.append(f"{name} : question {q + 1}, la bonne réponse n'est pas marquée juste")
@@ -1209,6 +1237,11 @@ def test_diagrams_and_quiz_answers_have_text_alternatives(site, browser):
                           "r.getAttribute('aria-label'))")
     assert names and all(re.fullmatch(r"Réponse [a-e] : .+", n) for n in names), names
     assert not any("\\" in n or "{" in n for n in names), names  # pas de TeX brut
+    # « Vérifier » au survol, en mode clair (issue 36 : fond et texte rgb(34, 40, 50))
+    button = page.locator(".kc-quiz-check").first
+    button.scroll_into_view_if_needed()
+    button.hover()
+    assert page.evaluate(_CONTRAST, button.element_handle()) >= 4.5
     page.context.close()
 
 

@@ -30,8 +30,10 @@ console) ; le mode sombre et les petits écrans ont leurs règles (``kc/kc-pages
 cachée (``kc``, ``np``…) : avant la première cellule visible, un bloc dépliable « Importations du
 chapitre » donne ces lignes d'importation, à copier d'abord.
 
-**Recherche.** Les extraits des résultats de recherche montrent les formules en texte lisible
-(« P⁻ », pas « \(P^-\) »).
+**Recherche.** Le champ de recherche parle français (« Rechercher dans le livre… ») ; l'index de
+recherche ne contient pas le TeX des formules (on ne trouve plus une page en cherchant « aligned ») ; les
+extraits des résultats montrent les formules en texte lisible (« P⁻ », pas « \(P^-\) ») et ne lisent que
+l'article de la page (ni sa table des matières, ni les importations : ``kc/kc-pages.js``).
 """
 
 from __future__ import annotations
@@ -43,8 +45,8 @@ from pathlib import Path
 
 from sphinx.util import logging
 
-__all__ = ["setup", "ASSETS", "css_glyphs", "icon_css", "fontawesome_icons", "hidden_imports", "subset_fonts", "imports_block", "mermaid_alt",
-           "extract_figure_data"]
+__all__ = ["setup", "ASSETS", "SEARCH_TEXT", "css_glyphs", "icon_css", "fontawesome_icons", "hidden_imports",
+           "subset_fonts", "imports_block", "mermaid_alt", "extract_figure_data", "without_math"]
 
 LOGGER = logging.getLogger(__name__)
 
@@ -52,6 +54,8 @@ LOGGER = logging.getLogger(__name__)
 ASSETS = Path(__file__).resolve().parent / "assets"
 #: Dossier des données des figures, sous ``_static/``.
 DATA_DIR = "kc-data"
+#: Le texte du champ de recherche (le thème écrit « Search this book... », sans traduction).
+SEARCH_TEXT = "Rechercher dans le livre…"
 
 _FIGURE_DATA = re.compile(r'<script type="application/json" id="(kc-[a-z0-9-]+)-item">(.*?)</script>', re.S)
 _CITATION_LIST = re.compile(r'<div role="list" class="citation-list">')
@@ -67,6 +71,9 @@ def _configure(app, config) -> None:
     Le menu contextuel de MathJax met chaque formule dans l'ordre de tabulation : s'il est chargé
     (``tex-chtml.js`` le contient), on l'en retire ; le livre charge MathJax en composants, sans menu
     (``_config.yml``), et n'a rien à régler."""
+    options = dict(config.html_theme_options or {})
+    options["search_bar_text"] = SEARCH_TEXT
+    config.html_theme_options = options
     mathjax = dict(config.mathjax3_config or {})
     load = (mathjax.get("loader") or {}).get("load")
     if load is not None and "ui/menu" not in load:
@@ -91,6 +98,32 @@ def _favicon(config) -> None:
 def _static_path(app) -> None:
     if app.builder.format == "html":
         app.config.html_static_path.append(str(ASSETS))
+        _index_without_math(app.builder)
+
+
+def without_math(doctree):
+    """Une copie de ``doctree`` sans ses formules (``math``, ``math_block``) : ce que lit l'index de recherche."""
+    from docutils import nodes
+
+    copy = doctree.deepcopy()
+    for node in list(copy.findall(lambda n: isinstance(n, (nodes.math, nodes.math_block)))):
+        node.parent.remove(node)
+    return copy
+
+
+def _index_without_math(builder) -> None:
+    """L'index de recherche de Sphinx lit le TeX des formules comme des mots (« aligned », « split »,
+    « mathbb ») : le constructeur lui donne une copie de chaque page sans ses formules. (Sphinx 7 n'a pas
+    de réglage pour cela ; ``index_page`` est la seule entrée de l'index, appelée avant l'écriture.)"""
+    index_page = getattr(builder, "index_page", None)
+    if index_page is None or getattr(index_page, "_kc_without_math", False):
+        return
+
+    def index_page_without_math(pagename, doctree, title):
+        return index_page(pagename, without_math(doctree), title)
+
+    index_page_without_math._kc_without_math = True
+    builder.index_page = index_page_without_math
 
 
 # --------------------------------------------------------------------------- page par page

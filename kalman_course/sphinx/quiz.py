@@ -11,8 +11,12 @@ chapitre (MyST) :
     Quand la variance de mesure $R$ diminue, le gain $K$…
 
     - diminue ;
+
+      C'est l'effet d'une mesure **moins** précise : $R$ grandit, la mesure pèse moins.
     - augmente ;
     - ne change pas.
+
+      Le gain dépend de $R$ : seule la prédiction ne le voit pas.
 
     $K = P^-/(P^- + R)$ croît quand $R$ décroît : la mesure, plus précise, pèse davantage.
     :::
@@ -20,15 +24,22 @@ chapitre (MyST) :
 
 Dans une question, ce qui précède la **première liste à puces** est l'énoncé, les éléments de la liste
 sont les réponses proposées (``:answer:`` : numéro de la bonne, à partir de 1), ce qui suit est
-l'explication. ``:name:`` donne un identifiant stable à la question (pour les tests).
+l'explication. Une réponse proposée peut porter, après une ligne vide et en retrait, son **message** :
+pour une mauvaise réponse, l'erreur qu'elle trahit (affiché quand on la choisit). ``:name:`` donne un
+identifiant stable à la question (pour les tests).
 
 - **HTML** : chaque question est un groupe de boutons radio, un bouton « Vérifier » et une zone de
   réponse ; quelques lignes de JavaScript sans dépendance, ajoutées une fois aux seules pages qui ont
-  un quiz, comparent le choix à la bonne réponse, l'annoncent (« Juste ! » ou « Pas tout à fait ») et
-  déplient l'explication. Aucun serveur, aucun noyau, aucune requête.
+  un quiz, comparent le choix à la bonne réponse, l'annoncent (« Juste ! » ou « Pas tout à fait »),
+  montrent le message de la réponse choisie et déplient l'explication. Aucun serveur, aucun noyau,
+  aucune requête.
 - **Autres sorties** (LaTeX/PDF, texte) : les questions deviennent une liste numérotée, les réponses
-  proposées des sous-listes (a), (b), (c)… et les bonnes réponses, avec leur explication, sont
-  regroupées sous un intertitre « Réponses du quiz » à la fin du chapitre.
+  proposées des sous-listes (a), (b), (c)… et les bonnes réponses, avec leur explication et le message de
+  chaque mauvaise réponse, sont regroupées sous un intertitre « Réponses du quiz » à la fin du chapitre.
+
+Les règles de rédaction (la bonne réponse n'est pas le plus souvent la plus longue, chaque mauvaise
+réponse a son message) sont vérifiées sur tout le livre par ``tests/test_quiz.py`` (:func:`quiz_questions`
+lit les questions d'une page MyST).
 """
 
 from __future__ import annotations
@@ -40,7 +51,8 @@ from docutils.parsers.rst import directives
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
-__all__ = ["setup", "QUIZ_MARKER", "QUIZ_SCRIPT", "quiz", "quiz_question", "tex_to_text", "choice_text"]
+__all__ = ["setup", "QUIZ_MARKER", "QUIZ_SCRIPT", "quiz", "quiz_question", "tex_to_text", "choice_text",
+           "QuizQuestion", "quiz_questions", "plain_text"]
 
 LOGGER = logging.getLogger(__name__)
 
@@ -72,6 +84,10 @@ class quiz_choice(nodes.General, nodes.TextElement):
 
 class quiz_explanation(nodes.General, nodes.Element):
     """L'explication, dépliée après la première vérification."""
+
+
+class quiz_why(nodes.General, nodes.Element):
+    """Le message d'une réponse proposée (``index`` : son numéro), montré quand on la choisit."""
 
 
 class QuizDirective(SphinxDirective):
@@ -120,16 +136,22 @@ class QuestionDirective(SphinxDirective):
         statement = quiz_statement()
         statement.extend(body.children[:k])
         choices = quiz_choices()
+        whys = []
         for index, item in enumerate(items, start=1):
             choice = quiz_choice(index=index)
-            content = item.children
-            # un seul paragraphe : son contenu en ligne (un <label> n'admet pas de <p>)
-            if len(content) == 1 and isinstance(content[0], nodes.paragraph):
-                content = content[0].children
+            content, why = item.children, []
+            # le premier paragraphe : la réponse, en ligne (un <label> n'admet pas de <p>) ; la suite : son message
+            if content and isinstance(content[0], nodes.paragraph):
+                content, why = content[0].children, content[1:]
             choice.extend([c.deepcopy() for c in content])
             choices += choice
+            if why:
+                node = quiz_why(index=index)
+                node.extend([c.deepcopy() for c in why])
+                whys.append(node)
         explanation = quiz_explanation()
         explanation.extend(body.children[k + 1:])
+        explanation.extend(whys)
         question += [statement, choices, explanation]
         return [question]
 
@@ -169,6 +191,7 @@ def tex_to_text(tex: str) -> str:
     t = re.sub(r"\\[dt]?frac\s*\{([^{}]*)\}\s*\{([^{}]*)\}", r"(\1)/(\2)", t)
     t = re.sub(r"\\sqrt\s*\{([^{}]*)\}", r"√(\1)", t)
     t = re.sub(r"\\(?:mathrm|mathbf|mathcal|mathbb|text|operatorname|boldsymbol)\s*\{([^{}]*)\}", r"\1", t)
+    t = re.sub(r"\\(?:begin|end)\s*\{[^{}]*\}(?:\{[^{}]*\})?", " ", t)  # environnements (aligned…)
     t = re.sub(r"\\(left|right|big|Big|bigl|bigr|Bigl|Bigr)\b", "", t)
     t = re.sub(r"\\([A-Za-z]+)", lambda m: _GREEK.get(m.group(1), ""), t)
     t = re.sub(r"\^\{([^{}]*)\}|\^(\S)", lambda m: _script(m.group(1) if m.group(1) is not None else m.group(2),
@@ -176,6 +199,7 @@ def tex_to_text(tex: str) -> str:
     t = re.sub(r"_\{([^{}]*)\}|_(\S)", lambda m: _script(m.group(1) if m.group(1) is not None else m.group(2),
                                                          _SUB, "_"), t)
     t = re.sub(r"\\[,;:!]", " ", t).replace("{", "").replace("}", "").replace("\\\\", " ").replace("\\", "")
+    t = t.replace("&", " ")  # colonnes d'alignement
     return " ".join(t.split())
 
 
@@ -195,6 +219,81 @@ def _ancestors(child, stop):
     while parent is not None and parent is not stop:
         yield parent
         parent = parent.parent
+
+
+# --------------------------------------------------------------------------- lecture des sources (tests)
+
+
+def plain_text(markdown: str) -> str:
+    """Le texte lu d'une ligne MyST : formules ``$…$`` écrites par :func:`tex_to_text`, marques de mise en
+    forme (``**``, ``*``, accents graves) retirées, espaces réduites."""
+    text = re.sub(r"\$([^$]+)\$", lambda m: tex_to_text(m.group(1)), markdown)
+    text = re.sub(r"\*\*|(?<!\w)\*|\*(?!\w)|`", "", text)
+    return " ".join(text.split())
+
+
+from dataclasses import dataclass, field  # noqa: E402
+
+
+@dataclass
+class QuizQuestion:
+    """Une question lue dans la source d'une page : ``answer`` (numéro de la bonne réponse, à partir de 1),
+    ``statement``, ``choices`` (texte de chaque réponse proposée), ``messages`` (message de chaque réponse,
+    vide s'il n'y en a pas), ``explanation``, ``line`` (ligne de la question dans la page)."""
+
+    answer: int
+    statement: str
+    choices: list[str] = field(default_factory=list)
+    messages: list[str] = field(default_factory=list)
+    explanation: str = ""
+    line: int = 0
+
+    def lengths(self) -> list[int]:
+        """Longueur lue de chaque réponse proposée (formules écrites en texte)."""
+        return [len(plain_text(c)) for c in self.choices]
+
+    def right_is_longest(self) -> bool:
+        """Vrai si la bonne réponse est la plus longue (à égalité comprise) : un élève qui choisit la plus
+        longue trouverait la bonne."""
+        lengths = self.lengths()
+        return lengths[self.answer - 1] >= max(lengths)
+
+
+_QUESTION = re.compile(r"^:::\{question\}[^\n]*\n(.*?)^:::\s*$", re.S | re.M)
+
+
+def quiz_questions(text: str) -> list[QuizQuestion]:
+    """Les questions de quiz d'une page MyST (source), dans l'ordre : la même lecture que la directive
+    (énoncé, première liste à puces, explication ; message d'une réponse après une ligne vide, en retrait)."""
+    out = []
+    for match in _QUESTION.finditer(text):
+        lines = match.group(1).splitlines()
+        answer = next((int(m.group(1)) for m in (re.match(r":answer:\s*(\d+)", li) for li in lines) if m), 0)
+        body = [li for li in lines if not re.match(r":\w+:", li)]
+        first = next((i for i, li in enumerate(body) if li.startswith("- ")), len(body))
+        statement = " ".join(li.strip() for li in body[:first])
+        choices, messages, explanation, rest = [], [], [], body[first:]
+        current: list[str] | None = None
+        in_message = False
+        for li in rest:
+            if li.startswith("- ") and not explanation:
+                choices.append(li[2:].strip())
+                messages.append("")
+                current, in_message = choices, False
+            elif not li.strip():
+                if current is not None and choices:
+                    in_message = True
+            elif li.startswith("  ") and choices and not explanation:
+                if in_message:
+                    messages[-1] = (messages[-1] + " " + li.strip()).strip()
+                else:
+                    choices[-1] = choices[-1] + " " + li.strip()
+            else:
+                explanation.append(li.strip())
+                current = None
+        line = text.count("\n", 0, match.start()) + 1
+        out.append(QuizQuestion(answer, statement, choices, messages, " ".join(explanation), line))
+    return out
 
 
 # --------------------------------------------------------------------------- numérotation
@@ -224,7 +323,12 @@ QUIZ_SCRIPT = r"""
     ".kc-quiz-choice input{margin-right:.5em}" +
     ".kc-quiz-check{margin:.4em 0;padding:.2em .9em;border:1px solid var(--pst-color-border,#888);" +
     "border-radius:4px;background:var(--pst-color-surface,#f6f8fa);color:var(--pst-color-text-base,#222);cursor:pointer}" +
-    ".kc-quiz-check:hover{background:var(--pst-color-on-surface,#eaeef2)}" +
+    // survol : fond et texte contrastés dans les deux modes (le fond « on-surface » du thème était la couleur du texte)
+    ".kc-quiz-check:hover{background:#0a55c0;border-color:#0a55c0;color:#fff}" +
+    "html[data-theme=dark] .kc-quiz-check:hover{background:#79b8ff;border-color:#79b8ff;color:#0d1117}" +
+    ".kc-quiz-why{margin:.2em 0 .4em;padding:.1em .6em;border-left:3px solid var(--pst-color-border,#888)}" +
+    ".kc-quiz-why>p{margin:.2em 0}" +
+    ".kc-quiz-wrong .kc-quiz-why{border-left-color:#cf222e}.kc-quiz-right .kc-quiz-why{border-left-color:#1a7f37}" +
     ".kc-quiz-feedback{font-weight:600;margin:.2em 0}" +
     ".kc-quiz-right .kc-quiz-feedback{color:#1a7f37}" +
     ".kc-quiz-wrong .kc-quiz-feedback{color:#cf222e}" +
@@ -250,8 +354,15 @@ QUIZ_SCRIPT = r"""
     }
     var right = chosen.value === question.getAttribute("data-answer");
     question.classList.add(right ? "kc-quiz-right" : "kc-quiz-wrong");
-    feedback.textContent = right ? "Juste\u00a0!" :
-      "Pas tout \u00e0 fait. R\u00e9essayez, ou d\u00e9pliez l\u2019explication.";
+    // le message de la réponse choisie (l'erreur qu'elle trahit), et lui seul
+    var why = null;
+    question.querySelectorAll(".kc-quiz-why").forEach(function (w) {
+      w.hidden = w.getAttribute("data-choice") !== chosen.value;
+      if (!w.hidden) why = w;
+    });
+    feedback.textContent = right ? "Juste\u00a0!" : (why ?
+      "Pas tout \u00e0 fait\u00a0: voici l\u2019erreur de cette r\u00e9ponse. R\u00e9essayez." :
+      "Pas tout \u00e0 fait. R\u00e9essayez, ou d\u00e9pliez l\u2019explication.");
     if (explanation) {
       explanation.hidden = false;
       explanation.open = right;
@@ -311,6 +422,15 @@ def depart_choice_html(self, node):
 
 
 def visit_explanation_html(self, node):
+    # messages des réponses (hors de l'explication dépliable : on les voit dès qu'on choisit), puis l'explication
+    whys = [c for c in node.children if isinstance(c, quiz_why)]
+    for why in whys:
+        node.remove(why)
+    if whys:
+        self.body.append('<div class="kc-quiz-whys" aria-live="polite">')
+        for why in whys:
+            why.walkabout(self)
+        self.body.append("</div>")
     if not node.children:
         raise nodes.SkipNode
     self.body.append('<details class="kc-quiz-explanation" hidden><summary>Explication</summary>')
@@ -318,6 +438,14 @@ def visit_explanation_html(self, node):
 
 def depart_explanation_html(self, node):
     self.body.append("</details>")
+
+
+def visit_why_html(self, node):
+    self.body.append(f'<div class="kc-quiz-why" data-choice="{node["index"]}" hidden>')
+
+
+def depart_why_html(self, node):
+    self.body.append("</div>")
 
 
 # --------------------------------------------------------------------------- autres sorties (LaTeX…)
@@ -343,7 +471,19 @@ def _as_plain_nodes(app, doctree, questions: list[quiz_question]) -> None:
             head = nodes.paragraph()
             head += nodes.strong(text=f"Question {q['number']}{_NBSP}: ({letter}) ")
             head.extend(c.deepcopy() for c in right.children)
-            answers.append([head, *explanation.children])
+            whys = [c for c in explanation.children if isinstance(c, quiz_why)]
+            block = [head, *[c for c in explanation.children if not isinstance(c, quiz_why)]]
+            if whys:  # l'erreur de chaque autre réponse, pour le corrigé de l'enseignant
+                listing_whys = nodes.bullet_list()
+                for why in whys:
+                    item = nodes.list_item()
+                    content = [c.deepcopy() for c in why.children]
+                    if content and isinstance(content[0], nodes.paragraph):
+                        content[0].insert(0, nodes.emphasis(text=f"({_LETTERS[why['index'] - 1]}){_NBSP}: "))
+                    item.extend(content)
+                    listing_whys += item
+                block.append(listing_whys)
+            answers.append(block)
         node.replace_self([rubric, listing])
     if not answers:
         return
@@ -378,6 +518,7 @@ def setup(app):
     app.add_node(quiz_choices, html=(visit_choices_html, depart_choices_html))
     app.add_node(quiz_choice, html=(visit_choice_html, depart_choice_html))
     app.add_node(quiz_explanation, html=(visit_explanation_html, depart_explanation_html))
+    app.add_node(quiz_why, html=(visit_why_html, depart_why_html))
     app.add_directive("quiz", QuizDirective)
     app.add_directive("question", QuestionDirective)
     app.connect("doctree-resolved", _resolve)
