@@ -253,6 +253,15 @@ WORDING = {
     r"\bobservateurs?\b(?! est un estimateur)(?!\s*»)": "« fonction d'observation » (un observateur est un estimateur)",
     r"\ble NIS\b": "« la NIS » (l'innovation normalisée)",
     r"regroupant les carrés": "« en complétant le carré »",
+    # relecture (issue 36) : un terme par notion, moins de personnification
+    r"\b(?:le|un|son|du|au|ce) NEES\b|\bNEES moyen\b": "« la NEES » (une erreur normalisée, comme « la NIS »)",
+    r"(?<!racine de l['’])\berreur quadratique moyenne\b":
+        "« racine de l'erreur quadratique moyenne (REQM) » (la valeur citée est une REQM)",
+    r"\b(?:la|une|sa|sans|cette|leur|propre|à|de) portes?\b(?!\s+(?:sur|le|la|les|l['’]|un|une|des|son|sa|ses|"
+    r"leur|aussi|bien|tout|toute|donc|alors|souvent)\b)": "« fenêtre de validation » (en anglais *gate*)",
+    r"\bse croi(?:t|ent)\b|\btrembl(?:e|ent|er)\b":
+        "ce que font l'estimation ou sa covariance (« suit le bruit des mesures », « sa covariance sous-estime "
+        "l'erreur »)",
 }
 
 
@@ -275,7 +284,9 @@ def test_wording_of_the_course(page):
     assert not problems, f"{page} : " + " ; ".join(problems)
 
 
-_SOFTWARE = re.compile(r"\b[Ll]es tests (?:du paquet )?(?:l[ea] |les |l['’])?(?:vérifient|comparent)|`test_\w+`")
+# (une phrase coupée en fin de ligne compte aussi ; un script de mesure nommé dans la prose aussi : issue 36)
+_SOFTWARE = re.compile(r"\b[Ll]es\s+tests\s+(?:du\s+paquet\s+)?(?:l[ea]\s+|les\s+|l['’])?(?:vérifient|comparent)"
+                       r"|`test_\w+`|`benchmarks/[\w./]+`")
 
 
 def software_talk_outside_boxes(text: str) -> list[str]:
@@ -289,6 +300,9 @@ def test_software_talk_check():
         == ["`test_joseph`", "Les tests vérifient"]
     assert software_talk_outside_boxes("C'est le même calcul. Les tests du paquet le vérifient.") == [
         "Les tests du paquet le vérifient"]
+    assert software_talk_outside_boxes("C'est un point fixe (les tests du\npaquet le vérifient), mesuré par "
+                                       "`benchmarks/imm.py`.") == ["les tests du\npaquet le vérifient",
+                                                                   "`benchmarks/imm.py`"]
     boxed = ":::{admonition} Dans le paquet\n:class: seealso\nLe test `test_joseph` la compare.\n:::\n"
     assert software_talk_outside_boxes("La covariance est juste.\n\n" + boxed) == []
 
@@ -614,3 +628,22 @@ def test_visible_cells_run_when_copied(page):
     que des noms qu'elles définissent ou que la page importe (bloc « Importations du chapitre »)."""
     problems = hidden_definitions_used_in_visible_cells(_text(page))
     assert not problems, f"{page} : noms définis dans une cellule cachée : {problems}"
+
+
+@pytest.mark.parametrize("chapter", LESSONS)
+def test_the_bridge_names_the_next_page(chapter):
+    """« La suite » renvoie à la page qui suit dans la table des matières (enkf sautait « Un seul filtre
+    gaussien » et « Quel filtre choisir ? », écrits après lui) : un chapitre inséré met à jour le précédent."""
+    keep = _text(chapter).split("## À retenir", 1)[1].split("\n## ", 1)[0]
+    bridge = re.search(r"^\*\*La suite\.\*\* (.+)$", keep, re.M)
+    cited = re.findall(r"\{doc\}`(?:[^`<]*<)?([\w-]+)>?`", bridge.group(1)) if bridge else []
+    following = TOC[TOC.index(chapter) + 1]
+    assert following in cited, f"{chapter} : « La suite » ne cite pas {following} (cite {cited})"
+
+
+def test_the_gaussian_chapter_names_the_chapters_it_builds_on():
+    """« Les deux chapitres précédents » (l'EKF et l'UKF) était faux depuis que le filtre particulaire et l'EnKF
+    les séparent de « Un seul filtre gaussien » : le chapitre les nomme."""
+    text = _text("filtre-gaussien")
+    assert "chapitres précédents" not in text
+    assert re.search(r"Les chapitres \{doc\}`ekf`\s+et \{doc\}`ukf`", text)

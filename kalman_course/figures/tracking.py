@@ -163,7 +163,7 @@ def two_sensors():
 
 
 @register("capteurs-porte", chapter=SENSORS_CHAPTER,
-          title="La porte : six positions aberrantes rejetées, puis une piste perdue derrière sa porte")
+          title="La fenêtre de validation : six positions aberrantes rejetées, puis une piste perdue derrière sa fenêtre")
 def gate_figure():
     track = heli.helicopter_track("position")
     study = heli.gate_study()
@@ -178,13 +178,13 @@ def gate_figure():
     win = slice(max(k - 12, 0), k + 14)
     ax.plot(track.y[win, 0], track.y[win, 1], "+", color=MEASURED, ms=7, label="positions vraies (mesurées)")
     ax.plot(y_bad[k, 0], y_bad[k, 1], "x", color="crimson", ms=10, mew=2, label="position aberrante")
-    ax.plot(plain.x[win, 0], plain.x[win, 1], color=POSITION_ONLY, lw=1.5, label="sans porte")
-    ax.plot(gated.x[win, 0], gated.x[win, 1], color=FUSED, lw=1.5, ls="--", label="porte p = 0,999")
+    ax.plot(plain.x[win, 0], plain.x[win, 1], color=POSITION_ONLY, lw=1.5, label="sans fenêtre")
+    ax.plot(gated.x[win, 0], gated.x[win, 1], color=FUSED, lw=1.5, ls="--", label="fenêtre de validation p = 0,999")
     ax.set_xlabel("est (m)")
     ax.set_ylabel("nord (m)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_title(f"Une position aberrante : écart maximal {fr(study.deviation_plain, '.0f')} m\n"
-                 f"sans porte, {fr(study.deviation_gated, '.0f')} m avec", fontsize=9)
+                 f"sans fenêtre, {fr(study.deviation_gated, '.0f')} m avec", fontsize=9)
     ax.legend(loc="best", fontsize=8)
     _grid(ax)
     ax = axes[1]
@@ -193,7 +193,7 @@ def gate_figure():
     ax.plot(track.y[:, 0] / 1e3, track.y[:, 1] / 1e3, "+", color=MEASURED, ms=4, label="positions mesurées")
     ax.plot(clean.x[:, 0] / 1e3, clean.x[:, 1] / 1e3, color=FUSED, lw=1.0, label=f"q appris ({fr(q, '.1f')} m²/s³)")
     ax.plot(quiet.x[:, 0] / 1e3, quiet.x[:, 1] / 1e3, color="crimson", lw=1.4,
-            label=f"q / 100, porte p = {fr(0.999, '.3f')}")
+            label=f"q / 100, fenêtre p = {fr(0.999, '.3f')}")
     rej = np.asarray(quiet.rejected)
     ax.plot(track.y[rej, 0] / 1e3, track.y[rej, 1] / 1e3, "o", mfc="none", color="crimson", ms=4, alpha=0.6,
             label="positions rejetées")

@@ -1,9 +1,9 @@
 r"""Curseurs des chapitres de pistage.
 
-* « Plusieurs capteurs, temps irrégulier » — la **porte** (probabilité :math:`p`) et la **densité**
+* « Plusieurs capteurs, temps irrégulier » — la **fenêtre de validation** (probabilité :math:`p`) et la **densité**
   :math:`q` du filtre sur l'hélicoptère SAMU 31, dont six positions ont été corrompues
   (:mod:`kalman_course.scenarios.helicopter`) : la trajectoire estimée et ses ellipses dans le plan, les
-  positions rejetées, la NIS de chaque position et le seuil de la porte.
+  positions rejetées, la NIS de chaque position et le seuil de la fenêtre.
 * « Cibles qui manœuvrent » — le **facteur d'oubli** :math:`\alpha` sur la cible simulée qui vire, et
   l'**IMM** : probabilité de changer de régime et densités des deux régimes
   (:mod:`kalman_course.scenarios.manoeuvre`).
@@ -52,7 +52,7 @@ def _joined(curves) -> tuple[np.ndarray, np.ndarray]:
 
 
 def gate_axes() -> tuple[ParameterAxis, ParameterAxis]:
-    """La porte :math:`p` (0,9 à 0,9999, ou aucune) et la densité :math:`q` (0,01 à 10 fois l'apprise)."""
+    """La fenêtre de validation :math:`p` (0,9 à 0,9999, ou aucune) et la densité :math:`q` (0,01 à 10 fois l'apprise)."""
     q_fit = heli.fitted_parameters("position")[0]
     return (
         ParameterAxis("gate", "p", "fenêtre de validation", "", np.array(GATES), default=2, scale="index",
@@ -64,7 +64,7 @@ def gate_axes() -> tuple[ParameterAxis, ParameterAxis]:
 
 
 def gate_run(gate: float, q: float) -> dict[str, np.ndarray]:
-    """Le filtre (positions seules, six positions corrompues) avec la porte ``gate`` (1 : aucune) et la
+    """Le filtre (positions seules, six positions corrompues) avec la fenêtre ``gate`` (1 : aucune) et la
     densité ``q`` : estimation, ellipses à 2σ, positions rejetées, NIS et seuil."""
     track = heli.helicopter_track("position")
     sp = heli.fitted_parameters("position")[1]
