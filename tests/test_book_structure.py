@@ -647,3 +647,47 @@ def test_the_gaussian_chapter_names_the_chapters_it_builds_on():
     text = _text("filtre-gaussien")
     assert "chapitres précédents" not in text
     assert re.search(r"Les chapitres \{doc\}`ekf`\s+et \{doc\}`ukf`", text)
+
+
+def test_glossary_has_the_notions_of_the_newest_chapters():
+    """Les notions des chapitres de pistage, du filtre gaussien, du choix d'un filtre et du filtrage parallèle,
+    avec leur nom anglais (chercher « gating » sur le site trouve le glossaire)."""
+    rows = {re.sub(r"[*«»]", "", r.split("|")[1]).strip().lower(): r.split("|")[2].lower()
+            for r in _text("glossaire").splitlines() if r.startswith("| ") and not r.startswith("| terme")}
+    for term, english in (("imm", "interacting multiple model"), ("régime, mode", "mode"),
+                          ("fenêtre de validation", "gating"), ("mémoire évanescente", "fading memory"),
+                          ("ajustement de covariance", "covariance matching"), ("cohérence", "consistency"),
+                          ("filtre gaussien", "gaussian filter"), ("cubature", "cubature"),
+                          ("gauss–hermite", "gauss–hermite"), ("iplf", "posterior linearisation"),
+                          ("produit préfixe", "prefix"), ("piste", "track")):
+        hits = [k for k in rows if k.startswith(term)]
+        assert hits and english in rows[hits[0]], term
+
+
+def test_bibliography_notes_use_the_words_of_the_course():
+    """Les notes de ``references.bib`` (imprimées dans les bibliographies) suivent le vocabulaire du cours :
+    la note de Durbin et Koopman disait encore « départ diffus exact »."""
+    notes = re.findall(r"^\s*note\s*=\s*\{(.*)\},?\s*$", (BOOK / "references.bib").read_text(), re.M)
+    assert len(notes) >= 10
+    problems = [p for note in notes for p in wording_problems(note)]
+    assert not problems, problems
+
+
+def test_readme_speaks_to_lecturers_on_one_screen_and_contributing_holds_the_machinery():
+    """Le README tient sur un écran (ce qu'est le cours, les deux commandes, publier, les TP) ; la CI lance
+    la commande de test qu'il donne ; le détail des tests (sessions, caches, CI) est dans CONTRIBUTING.md."""
+    readme = (ROOT / "README.md").read_text()
+    assert len(readme.splitlines()) <= 50
+    sections = re.findall(r"^## (.+)$", readme, re.M)
+    assert sections[:3] == ["Les deux commandes", "Publier", "Travaux pratiques"], sections
+    commands = re.findall(r"^bash (scripts/\S+)", readme, re.M)
+    assert commands == ["scripts/build.sh", "scripts/test.sh"]
+    assert "bash scripts/test.sh || status=$?" in (ROOT / ".ci" / "run").read_text()
+    assert "bash scripts/lab.sh" in readme and "CONTRIBUTING.md" in readme
+    for detail in ("KALMAN_GRID_CACHE", "cache d'exécution", "fmtutil.cnf"):  # la machinerie des tests
+        assert detail not in readme, detail
+    contributing = (ROOT / "CONTRIBUTING.md").read_text()
+    for heading in ("## Écrire un chapitre : ce que vérifient les tests", "## Organisation",
+                    "## Publier le livre : boutons de lancement"):
+        assert heading in contributing, heading
+    assert "KALMAN_GRID_CACHE" in contributing and "`.ci/run`" in contributing
