@@ -31,7 +31,8 @@ def main() -> int:
     parser.add_argument("--height", type=int, default=900)
     parser.add_argument("--full", action="store_true", help="page entière")
     parser.add_argument("--dark", action="store_true", help="mode sombre du thème")
-    parser.add_argument("--selector", help="capturer ce seul élément (sélecteur CSS), amené à l'écran")
+    parser.add_argument("--selector", help="amener cet élément (sélecteur CSS) en haut de l'écran ; avec --full, "
+                        "ne capturer que lui, en entier")
     parser.add_argument("--query", default="", help="suffixe de l'adresse (« ?q=porte » pour la recherche)")
     args = parser.parse_args()
     root = args.root.resolve()
@@ -64,8 +65,13 @@ def main() -> int:
         if args.selector:
             target = page.locator(args.selector).first
             target.scroll_into_view_if_needed()
-            page.wait_for_timeout(1500)  # figures à curseurs dessinées quand elles approchent de l'écran
-            target.screenshot(path=str(args.out))
+            page.wait_for_timeout(2500)  # figures à curseurs dessinées quand elles approchent de l'écran
+            if args.full:  # l'élément entier (les curseurs collés sous l'en-tête peuvent s'y déplacer)
+                target.screenshot(path=str(args.out))
+            else:  # l'écran, l'élément en haut : ce que voit le lecteur
+                target.evaluate("el => el.scrollIntoView({block: 'start'})")
+                page.wait_for_timeout(1000)
+                page.screenshot(path=str(args.out))
         else:
             page.screenshot(path=str(args.out), full_page=args.full)
         browser.close()

@@ -232,3 +232,11 @@ def test_the_introduction_quiz_asks_about_the_filter_not_the_book():
     words = " ".join(q.statement + " " + q.explanation for q in questions).lower()
     for notion in ("gain", "prédiction", "mesure"):
         assert notion in words, notion
+
+
+def test_choices_of_equal_length_give_nothing_away():
+    from kalman_course.sphinx.quiz import QuizQuestion
+
+    assert not QuizQuestion(3, "Q ?", ["$A$", "$B$", "$C$"]).right_is_longest()
+    assert QuizQuestion(2, "Q ?", ["ab", "abc", "abc"]).right_is_longest()  # à égalité avec une autre : 1 chance sur 2
+    assert not QuizQuestion(1, "Q ?", ["ab", "abc", "abc"]).right_is_longest()

@@ -109,13 +109,20 @@ def gate_spec() -> SliderSpec:
     bad = np.flatnonzero(track.position_rows)[list(heli.OUTLIER_ROWS)]
     e, n = np.asarray(track.y)[:, 0] / 1e3, np.asarray(track.y)[:, 1] / 1e3
     zoom = np.asarray(track.y)[bad[list(ZOOM_ROWS)], :2].mean(axis=0) / 1e3
-    plane = lambda clip: (  # noqa: E731 — les tracés du plan, coupés par le cadre de l'agrandissement
-        Glyph("meas_n", "scatter", "gray", "positions mesurées", x="meas_e", marker="cross", size=5, clip=clip),
-        Glyph("out_n", "scatter", "crimson", "positions aberrantes", x="out_e", marker="x", size=11, clip=clip),
-        Glyph("ell_n", "line", "royalblue", "ellipses à 2σ", x="ell_e", width=1.0, alpha=0.7, clip=clip),
-        Glyph("est_n", "line", "darkorange", "estimation", x="est_e", width=1.8, clip=clip),
-        Glyph("rej_n", "scatter", "black", "positions rejetées", x="rej_e", marker="circle", size=7, clip=clip),
-    )
+    def plane(zoom: bool) -> tuple[Glyph, ...]:
+        """Les tracés du plan ; dans l'agrandissement, coupés par son cadre et sans légende (la même)."""
+        def name(text: str) -> str:
+            return "" if zoom else text
+        return (
+            Glyph("meas_n", "scatter", "gray", name("positions mesurées"), x="meas_e", marker="cross", size=5,
+                  clip=zoom),
+            Glyph("ell_n", "line", "royalblue", name("ellipses à 2σ"), x="ell_e", width=1.0, alpha=0.7, clip=zoom),
+            Glyph("est_n", "line", "darkorange", name("estimation"), x="est_e", width=1.8, clip=zoom),
+            Glyph("rej_n", "scatter", "black", name("positions rejetées"), x="rej_e", marker="circle", size=9,
+                  clip=zoom),
+            Glyph("out_n", "scatter", "crimson", name("positions aberrantes"), x="out_e", marker="x", size=11,
+                  clip=zoom),
+        )
     return SliderSpec(
         name="capteurs-porte-curseurs",
         chapter=SENSORS_CHAPTER,

@@ -239,7 +239,8 @@ from dataclasses import dataclass, field  # noqa: E402
 class QuizQuestion:
     """Une question lue dans la source d'une page : ``answer`` (numéro de la bonne réponse, à partir de 1),
     ``statement``, ``choices`` (texte de chaque réponse proposée), ``messages`` (message de chaque réponse,
-    vide s'il n'y en a pas), ``explanation``, ``line`` (ligne de la question dans la page)."""
+    vide s'il n'y en a pas), ``explanation``, ``line`` (ligne de la question dans la page), ``name`` (option
+    ``:name:``, vide sans elle)."""
 
     answer: int
     statement: str
@@ -247,6 +248,7 @@ class QuizQuestion:
     messages: list[str] = field(default_factory=list)
     explanation: str = ""
     line: int = 0
+    name: str = ""
 
     def lengths(self) -> list[int]:
         """Longueur lue de chaque réponse proposée (formules écrites en texte)."""
@@ -254,9 +256,10 @@ class QuizQuestion:
 
     def right_is_longest(self) -> bool:
         """Vrai si la bonne réponse est la plus longue (à égalité comprise) : un élève qui choisit la plus
-        longue trouverait la bonne."""
+        longue la trouverait (ou aurait plus de chances de la trouver qu'au hasard). Des réponses toutes de
+        même longueur (« $A$ », « $B$ », « $C$ ») ne trahissent rien."""
         lengths = self.lengths()
-        return lengths[self.answer - 1] >= max(lengths)
+        return lengths[self.answer - 1] >= max(lengths) and len(set(lengths)) > 1
 
 
 _QUESTION = re.compile(r"^:::\{question\}[^\n]*\n(.*?)^:::\s*$", re.S | re.M)
@@ -269,6 +272,7 @@ def quiz_questions(text: str) -> list[QuizQuestion]:
     for match in _QUESTION.finditer(text):
         lines = match.group(1).splitlines()
         answer = next((int(m.group(1)) for m in (re.match(r":answer:\s*(\d+)", li) for li in lines) if m), 0)
+        name = next((m.group(1) for m in (re.match(r":name:\s*(\S+)", li) for li in lines) if m), "")
         body = [li for li in lines if not re.match(r":\w+:", li)]
         first = next((i for i, li in enumerate(body) if li.startswith("- ")), len(body))
         statement = " ".join(li.strip() for li in body[:first])
@@ -292,7 +296,7 @@ def quiz_questions(text: str) -> list[QuizQuestion]:
                 explanation.append(li.strip())
                 current = None
         line = text.count("\n", 0, match.start()) + 1
-        out.append(QuizQuestion(answer, statement, choices, messages, " ".join(explanation), line))
+        out.append(QuizQuestion(answer, statement, choices, messages, " ".join(explanation), line, name))
     return out
 
 
