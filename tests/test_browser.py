@@ -1263,3 +1263,49 @@ def test_search_shows_readable_snippets(site, browser):
         assert not re.search(r"\\\(|\\\)|\\\[|\\[a-zA-Z]{2,}", r["text"]), r["text"][:200]
     assert not page_errors(visit, "")
     page.context.close()
+
+
+def _search(site, browser, query: str) -> tuple[Visit, list[dict]]:
+    visit = open_page(browser, site.base + f"search.html?q={query}", site.base, figures=False)
+    page = visit.page
+    page.wait_for_function("() => document.querySelector('#search-results .search-summary, #search-results p')",
+                           timeout=30000)
+    page.wait_for_timeout(1500)  # les extraits arrivent page par page
+    results = page.evaluate("""() => [...document.querySelectorAll('#search-results li')].map(li => ({
+        href: li.querySelector('a').getAttribute('href'), text: li.textContent}))""")
+    return visit, results
+
+
+def test_search_speaks_french_and_reads_the_article_only(site, browser):
+    """La recherche (issue 36) : le champ dit « Rechercher dans le livre… » et sa loupe ne couvre pas le texte
+    tapé ; l'index ne contient pas le TeX des formules (« aligned » ne trouve rien) ; « gating » trouve le
+    glossaire ; les extraits ne montrent ni le TeX d'un environnement (« && ») ni la table des matières de la
+    page, ni ses importations."""
+    visit, results = _search(site, browser, "gauss")
+    page = visit.page
+    field = page.locator("form.bd-search input[type=search]").first
+    assert field.get_attribute("placeholder") == "Rechercher dans le livre…"
+    gap = page.evaluate("""() => {
+        const form = document.querySelector('.bd-search-container form.bd-search') ||
+                     document.querySelector('form.bd-search');
+        const icon = form.querySelector('.fa-magnifying-glass').getBoundingClientRect();
+        const input = form.querySelector('input');
+        const start = input.getBoundingClientRect().left + parseFloat(getComputedStyle(input).paddingLeft);
+        return start - icon.right;
+    }""")
+    assert gap >= 0, f"la loupe recouvre le texte du champ de {-gap:.1f} px"
+    gaussian = [r for r in results if "filtre-gaussien" in r["href"]]
+    assert gaussian, [r["href"] for r in results]
+    for r in results:
+        assert "&&" not in r["text"] and "aligned" not in r["text"], r["text"][:200]
+        assert "Importations du chapitre" not in r["text"], r["text"][:200]
+    # la table des matières de la page : ses titres de sections, à la suite
+    assert "Quatre règles pour trois intégrales La banane" not in " ".join(gaussian[0]["text"].split())
+    close_visit(visit, None)
+    visit, results = _search(site, browser, "aligned")
+    assert results == [], [r["href"] for r in results]
+    close_visit(visit, None)
+    visit, results = _search(site, browser, "gating")
+    assert any("glossaire" in r["href"] for r in results), [r["href"] for r in results]
+    assert any("capteurs-temps-irregulier" in r["href"] for r in results), [r["href"] for r in results]
+    close_visit(visit, None)
