@@ -240,3 +240,23 @@ def test_choices_of_equal_length_give_nothing_away():
     assert not QuizQuestion(3, "Q ?", ["$A$", "$B$", "$C$"]).right_is_longest()
     assert QuizQuestion(2, "Q ?", ["ab", "abc", "abc"]).right_is_longest()  # à égalité avec une autre : 1 chance sur 2
     assert not QuizQuestion(1, "Q ?", ["ab", "abc", "abc"]).right_is_longest()
+
+
+def test_latex_gathers_the_answers_at_the_end_of_each_chapter(tmp_path):
+    """Le LaTeX d'un livre est un seul arbre (un ``start_of_file`` par chapitre) : les réponses restaient
+    toutes à la fin du premier chapitre, numérotées de 1 à 105. Chaque chapitre a les siennes, numérotées à
+    partir de 1, après son propre texte."""
+    def chapter(n):
+        return GOOD.replace("# Chapitre", f"# Chapitre {n}").replace("Deuxième question", f"Deuxième question du {n}")
+
+    index = "# Livre\n\n```{toctree}\nun\ndeux\n```\n"
+    src = _project(tmp_path, index, {"un.md": chapter("un"), "deux.md": chapter("deux")})
+    code, out, log = _build(src, "latex")
+    assert code == 0, log
+    tex = next(out.glob("*.tex")).read_text()
+    assert tex.count("Réponses du quiz") == 2
+    first, second = tex.split("Réponses du quiz")[1:]
+    assert "Chapitre deux" in first and "Chapitre deux" not in second  # les réponses de un, avant deux
+    for part in (first, second):
+        assert re.search(r"Question 1\s*:", part) and re.search(r"Question 2\s*:", part)
+        assert not re.search(r"Question 3\s*:", part)

@@ -69,7 +69,7 @@ def choice_spec() -> SliderSpec:
     err = tuple(Glyph(f"{_key(n)}_err", "line", c, n, dash=d) for n, (c, d) in COLORS.items())
     nees = tuple(Glyph(f"{_key(n)}_nees", "line", c, n, dash=d) for n, (c, d) in COLORS.items())
     # la bande que le texte demande de regarder : aussi visible que les autres surfaces du livre
-    band = (Glyph("band_lo", "band", "green", "bande verte : NEES moyenne cohérente (95 %)", upper="band_hi"),)
+    band = (Glyph("band_lo", "band", "green", "bande verte (95 %)", upper="band_hi"),)
     T = TARGET_STEPS
     return SliderSpec(
         name="choix-incertitude",

@@ -303,12 +303,38 @@ def quiz_questions(text: str) -> list[QuizQuestion]:
 # --------------------------------------------------------------------------- numérotation
 
 
+def _chapter_of(node, docname: str) -> str:
+    """Le document (chapitre) d'un nœud. Dans le LaTeX, tout le livre est un seul arbre : Sphinx y range chaque
+    chapitre dans un ``start_of_file`` et marque ses sections de son nom (``section["docname"]``) ; sur le
+    site, chaque page est son propre arbre (``docname``)."""
+    parent = node.parent
+    while parent is not None:
+        if isinstance(parent, nodes.section) and parent.get("docname"):
+            return parent["docname"]
+        parent = parent.parent
+    return docname
+
+
+def _chapter_top(doctree, chapter: str, docname: str):
+    """La section de tête du chapitre ``chapter`` dans ``doctree`` (l'arbre lui-même à défaut)."""
+    for section in doctree.findall(nodes.section):
+        if section.get("docname", docname) == chapter:
+            return section
+    return doctree
+
+
 def _number_questions(app, doctree, docname: str) -> list[quiz_question]:
+    """Numérote les questions de chaque chapitre à partir de 1 (dans le LaTeX aussi, où le livre entier est un
+    seul arbre)."""
     questions = list(doctree.findall(quiz_question))
-    slug = re.sub(r"[^a-z0-9]+", "-", docname.lower()).strip("-")
-    for k, q in enumerate(questions, start=1):
+    counts: dict[str, int] = {}
+    for q in questions:
+        chapter = _chapter_of(q, docname)
+        counts[chapter] = k = counts.get(chapter, 0) + 1
+        slug = re.sub(r"[^a-z0-9]+", "-", chapter.lower()).strip("-")
         q["number"] = k
         q["qid"] = f"kc-quiz-{slug}-{k}"
+        q["chapter"] = chapter
     return questions
 
 
@@ -455,10 +481,12 @@ def depart_why_html(self, node):
 # --------------------------------------------------------------------------- autres sorties (LaTeX…)
 
 
-def _as_plain_nodes(app, doctree, questions: list[quiz_question]) -> None:
-    """Remplace chaque quiz par des listes ordinaires et regroupe les réponses en fin de chapitre."""
-    answers = []
+def _as_plain_nodes(app, doctree, questions: list[quiz_question], docname: str = "") -> None:
+    """Remplace chaque quiz par des listes ordinaires et regroupe les réponses à la fin de **son** chapitre
+    (le LaTeX du livre est un seul arbre : un intertitre « Réponses du quiz » par chapitre)."""
+    answers: dict[str, list] = {}
     for node in list(doctree.findall(quiz)):
+        chapter = next((q["chapter"] for q in node.children if isinstance(q, quiz_question)), docname)
         rubric = nodes.rubric(text=node["title"] or "Quiz")
         listing = nodes.enumerated_list(enumtype="arabic", prefix="", suffix=".")
         for q in [c for c in node.children if isinstance(c, quiz_question)]:
@@ -487,18 +515,17 @@ def _as_plain_nodes(app, doctree, questions: list[quiz_question]) -> None:
                     item.extend(content)
                     listing_whys += item
                 block.append(listing_whys)
-            answers.append(block)
+            answers.setdefault(chapter, []).append(block)
         node.replace_self([rubric, listing])
-    if not answers:
-        return
-    # un intertitre (rubrique), pas une section : ni numéro ni entrée dans la table des matières, et la
-    # page d'accueil, dont LaTeX aplatit les sections, n'en fait pas une « partie » avant le cours
-    heading = nodes.rubric(text="Réponses du quiz", ids=["kc-quiz-reponses"])
-    top = next(iter(doctree.findall(nodes.section)), None)
-    target = top if top is not None else doctree
-    target.append(heading)
-    for block in answers:
-        target.extend(block)
+    for chapter, blocks in answers.items():
+        # un intertitre (rubrique), pas une section : ni numéro ni entrée dans la table des matières, et la
+        # page d'accueil, dont LaTeX aplatit les sections, n'en fait pas une « partie » avant le cours
+        slug = re.sub(r"[^a-z0-9]+", "-", chapter.lower()).strip("-")
+        heading = nodes.rubric(text="Réponses du quiz", ids=[f"kc-quiz-reponses-{slug}"])
+        target = _chapter_top(doctree, chapter, docname)
+        target.append(heading)
+        for block in blocks:
+            target.extend(block)
 
 
 def _resolve(app, doctree, docname: str) -> None:
@@ -506,7 +533,7 @@ def _resolve(app, doctree, docname: str) -> None:
     if not questions:
         return
     if app.builder.format != "html":
-        _as_plain_nodes(app, doctree, questions)
+        _as_plain_nodes(app, doctree, questions, docname)
 
 
 def _add_script(app, pagename, templatename, context, doctree) -> None:
