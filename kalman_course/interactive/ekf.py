@@ -113,7 +113,7 @@ def ekf_spec() -> SliderSpec:
                 x_label="azimut θ (°)",
                 x_range=(-180.0, 180.0),
                 y_range=(-11.0, 11.0),
-                height=220,
+                height=260,  # légende sur quatre lignes sur un téléphone
             ),
         ),
         fixed={"f_x": r_hat * np.cos(np.deg2rad(ANGLES))},
