@@ -297,6 +297,27 @@ def test_benchmark_acceptance_on_fifty_runs():
                                                   s.heading_nees))
 
 
+def test_the_cached_table_and_curves_of_the_chapter_are_the_package_results():
+    """Le chapitre cite le banc d'essai de 100 tirages écrit par benchmarks/localization.py --write : il est
+    redonné par localization_curves (tableau à 1e-9, courbes à l'arrondi de 4 chiffres près) ; l'EKF invariant
+    muni du G de ukfm y retrouve une NEES de position voisine de celle qu'imprime ukfm (2,02)."""
+    from kalman_course.scenarios import robot_localization_results as cached
+
+    curves = rl.localization_curves(cached.N_RUNS, rng=cached.SEED, ukfm_g=True)
+    for kind, row in cached.TABLE.items():
+        s = curves.scores(kind)
+        np.testing.assert_allclose((s.position_rmse, s.heading_rmse_deg, s.position_nees, s.heading_nees), row,
+                                   rtol=1e-9, err_msg=kind)
+    pick = slice(19, None, 20)
+    np.testing.assert_allclose(cached.CURVE_TIME, curves.t[pick], rtol=1e-12)
+    for key, values in cached.CURVES.items():
+        kind, name = key.split()
+        np.testing.assert_allclose(values, curves.curves[kind][name][pick], rtol=6e-4, err_msg=key)
+    inv, std, ukfm = (cached.TABLE[k] for k in ("invariant", "standard", "invariant_ukfm"))
+    assert 0.38 <= inv[0] <= 0.52 and std[0] >= 1.4 * inv[0] and 0.7 <= inv[2] <= 1.5 and std[2] >= 20
+    assert 1.6 <= ukfm[2] <= 3.0 and abs(ukfm[0] - inv[0]) < 0.01  # même erreur, covariance trop optimiste
+
+
 def test_benchmark_data_follow_ukfm_settings():
     d = rl.localization_data(3, rng=1)
     assert d.y.shape == (3, 3999, 2) and d.u.shape == (3, 3999, 3) and d.truth.shape == (4000, 3, 3)

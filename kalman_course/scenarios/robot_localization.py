@@ -173,6 +173,17 @@ class LocalizationCurves:
 _FILTERS = {"invariant": se2_invariant_ekf_runs, "standard": se2_standard_ekf_runs}
 
 
+def ukfm_noise_model(model: OdometryGnssModel) -> OdometryGnssModel:
+    r"""Le modèle de bruit que voit l'EKF invariant de ukfm : sa matrice :math:`G = dt\,I` range le bruit
+    :math:`[w_{v_x}, w_{v_y}, w_\omega]` sur son erreur :math:`[\theta, x, y]` dans l'ordre des indices, donc
+    :math:`\sigma_{v_x}` sur le cap, :math:`\sigma_{v_y}` sur :math:`x` et :math:`\sigma_\omega` sur :math:`y`. Dans
+    l'ordre du paquet :math:`[\rho_x, \rho_y, \theta]`, c'est le modèle aux écarts-types
+    :math:`[\sigma_{v_y}, \sigma_\omega, \sigma_{v_x}]` (à la rotation :math:`\mathrm{Exp}(\omega\,dt)^T` près, de
+    0,09° par pas)."""
+    s = model.odometry_std
+    return OdometryGnssModel(model.dt, [s[1], s[2], s[0]], model.gnss_std)
+
+
 def _errors(truth: np.ndarray, res) -> tuple[np.ndarray, ...]:
     """Erreurs (N, K, 2) et (N, K) et NEES (N, K) de position et de cap d'un lot filtré."""
     e_p = truth[None, 1:, :2, 2] - res.position
@@ -186,22 +197,30 @@ def _errors(truth: np.ndarray, res) -> tuple[np.ndarray, ...]:
     return e_p, e_t, nees_p, nees_t
 
 
-def _run_curves(data: LocalizationData, chunk: int = CHUNK) -> LocalizationCurves:
+_CURVE_NAMES = ("position_mse", "heading_mse", "position_nees", "heading_nees")
+
+
+def _curve_terms(truth, res) -> dict[str, np.ndarray]:
+    """Par tirage et par ligne (N, K) : erreurs quadratiques de position (m²) et de cap (rad²), NEES."""
+    e_p, e_t, nees_p, nees_t = _errors(truth, res)
+    return {"position_mse": np.sum(e_p**2, axis=-1), "heading_mse": e_t**2, "position_nees": nees_p,
+            "heading_nees": nees_t}
+
+
+def _run_curves(data: LocalizationData, chunk: int = CHUNK, filters: dict | None = None) -> LocalizationCurves:
+    """Les filtres ``filters`` (nom → (filtre en lot, modèle du filtre) ; par défaut les deux filtres avec le
+    modèle des données) sur toutes les données, par paquets de ``chunk`` tirages."""
     N, K = data.y.shape[:2]
-    sums = {kind: {name: np.zeros(K) for name in ("position_mse", "heading_mse", "position_nees", "heading_nees")}
-            for kind in _FILTERS}
+    filters = filters or {kind: (run, data.model) for kind, run in _FILTERS.items()}
+    sums = {kind: {name: np.zeros(K) for name in _CURVE_NAMES} for kind in filters}
     example = {"truth": np.array(data.truth[:, :2, 2]),
                "gnss": np.array(data.y[0][~np.isnan(data.y[0, :, 0])])}
     for start in range(0, N, chunk):
         sl = slice(start, min(N, start + chunk))
-        for kind, run in _FILTERS.items():
-            res = run(data.model, data.y[sl], data.T0[sl], data.P0, data.u[sl])
-            e_p, e_t, nees_p, nees_t = _errors(data.truth, res)
-            s = sums[kind]
-            s["position_mse"] += np.sum(e_p**2, axis=(0, 2))
-            s["heading_mse"] += np.sum(e_t**2, axis=0)
-            s["position_nees"] += np.sum(nees_p, axis=0)
-            s["heading_nees"] += np.sum(nees_t, axis=0)
+        for kind, (run, model) in filters.items():
+            res = run(model, data.y[sl], data.T0[sl], data.P0, data.u[sl])
+            for name, values in _curve_terms(data.truth, res).items():
+                sums[kind][name] += values.sum(axis=0)
             if start == 0:
                 example[kind] = np.array(res.position[0])
             del res
@@ -210,11 +229,17 @@ def _run_curves(data: LocalizationData, chunk: int = CHUNK) -> LocalizationCurve
 
 
 def localization_curves(n_runs: int, *, rng: Any, heading_std: float = HEADING_STD, gnss_every: int = GNSS_EVERY,
-                        odometry_scale: float = 1.0, n_instants: int = N_INSTANTS) -> LocalizationCurves:
-    """Les deux filtres sur ``n_runs`` tirages de :func:`localization_data` : courbes moyennes au cours du temps."""
+                        odometry_scale: float = 1.0, n_instants: int = N_INSTANTS,
+                        ukfm_g: bool = False) -> LocalizationCurves:
+    """Les deux filtres sur ``n_runs`` tirages de :func:`localization_data` : courbes moyennes au cours du temps.
+    ``ukfm_g=True`` ajoute l'EKF invariant avec le bruit que lui donne ukfm (:func:`ukfm_noise_model`), sous le
+    nom ``"invariant_ukfm"``."""
     data = localization_data(n_runs, rng=rng, heading_std=heading_std, gnss_every=gnss_every,
                              odometry_scale=odometry_scale, n_instants=n_instants)
-    return _run_curves(data)
+    filters = {kind: (run, data.model) for kind, run in _FILTERS.items()}
+    if ukfm_g:
+        filters["invariant_ukfm"] = (se2_invariant_ekf_runs, ukfm_noise_model(data.model))
+    return _run_curves(data, filters=filters)
 
 
 def localization_benchmark(n_runs: int = 100, *, rng: Any) -> LocalizationBenchmark:
@@ -244,3 +269,86 @@ def tiny_error_agreement(heading_std_deg: float = 0.01, rng: int = 35) -> float:
     a = se2_invariant_ekf_runs(data.model, data.y, data.T0, data.P0, data.u)
     b = se2_standard_ekf_runs(data.model, data.y, data.T0, data.P0, data.u)
     return float(max(np.max(np.abs(a.position - b.position)), np.max(np.abs(wrap_angle(a.heading - b.heading)))))
+
+
+# --------------------------------------------------------------------------- l'expérience des curseurs
+
+#: Les curseurs du chapitre rejouent le banc d'essai en plus léger : odométrie à 10 Hz (400 instants, 40 s),
+#: :data:`SLIDER_RUNS` tirages par position des curseurs, erreurs initiales de cap aux quantiles
+#: :math:`(i + 1/2)/M` de la loi normale (un échantillon régulier, sans tirage chanceux ni malchanceux),
+#: mêmes bruits d'odométrie et de GNSS (nombres aléatoires communs) à toutes les positions. À 10 Hz, les
+#: écarts-types par mesure de l'odométrie sont ceux du banc d'essai divisés par √10 : même dérive par seconde
+#: (variance :math:`\sigma^2dt` par seconde).
+SLIDER_DT = 0.1
+SLIDER_INSTANTS = 400
+SLIDER_RUNS = 8
+SLIDER_SEED = 35
+SLIDER_HEADINGS_DEG = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)
+SLIDER_GNSS_PERIODS = (0.5, 1.0, 2.0)
+SLIDER_ODOMETRY_SCALES = (0.3, 1.0, 3.0)
+#: Un point des courbes des curseurs toutes les SLIDER_EVERY lignes (0,4 s).
+SLIDER_EVERY = 4
+#: Première ligne des moyennes des curseurs (t ≥ 20 s).
+SLIDER_FROM = 199
+
+
+@dataclass(frozen=True, eq=False)
+class SliderStudy:
+    r"""L'expérience des curseurs pour un bruit d'odométrie : ``t`` (L,) instants des courbes (s) ;
+    ``runs[(cap en °, période GNSS en s)]`` → séries moyennes sur les :data:`SLIDER_RUNS` tirages, pour
+    ``inv`` (EKF invariant) et ``std`` (EKF standard) : ``*_nees`` (L,) NEES de position, ``*_rmse`` (L,) erreur
+    quadratique moyenne de position (m), ``*_nees_mean`` et ``*_rmse_mean`` (1,) : NEES moyenne sur
+    t ≥ 20 s et RMSE sur tout le trajet."""
+
+    odometry_scale: float
+    t: np.ndarray
+    runs: dict
+
+
+def _heading_quantiles(M: int) -> np.ndarray:
+    from scipy.special import ndtri
+
+    return ndtri((np.arange(M) + 0.5) / M)
+
+
+@lru_cache(maxsize=4)
+def slider_study(odometry_scale: float) -> SliderStudy:
+    """Les deux filtres, en un lot chacun, sur toutes les positions des curseurs de cap et de période GNSS
+    (7 × 3 × :data:`SLIDER_RUNS` tirages) pour ce bruit d'odométrie (multiple de celui du banc d'essai,
+    :data:`ODOMETRY_STD` à 100 Hz)."""
+    M, dt = SLIDER_RUNS, SLIDER_DT
+    g = np.random.default_rng(SLIDER_SEED)
+    truth = true_poses(SLIDER_INSTANTS, dt)
+    K = truth.shape[0] - 1
+    z_odo = g.standard_normal((M, K, 3))
+    z_gnss = g.standard_normal((M, K, 2))
+    q = _heading_quantiles(M)
+    model = OdometryGnssModel(dt, odometry_scale * ODOMETRY_STD * np.sqrt(DT / dt), GNSS_STD)
+    keys = [(h, period) for h in SLIDER_HEADINGS_DEG for period in SLIDER_GNSS_PERIODS]
+    N = len(keys) * M
+    y = np.full((N, K, 2), np.nan)
+    T0 = np.zeros((N, 3, 3))
+    P0 = np.zeros((N, 3, 3))
+    for j, (h, period) in enumerate(keys):
+        sl = slice(j * M, (j + 1) * M)
+        every = int(round(period / dt))
+        rows = np.arange(every, K + 1, every) - 1
+        y[sl, rows] = truth[rows + 1, :2, 2] + GNSS_STD * z_gnss[:, rows]
+        eps = np.radians(h) * q
+        T0[sl, 0, 0], T0[sl, 0, 1], T0[sl, 1, 0], T0[sl, 1, 1], T0[sl, 2, 2] = (
+            np.cos(eps), -np.sin(eps), np.sin(eps), np.cos(eps), 1.0)
+        P0[sl, 2, 2] = np.radians(h) ** 2
+    u = np.array([SPEED, 0.0, TURN_RATE]) + model.odometry_std * np.tile(z_odo, (len(keys), 1, 1))
+    pick = slice(SLIDER_EVERY - 1, None, SLIDER_EVERY)
+    runs = {key: {} for key in keys}
+    for prefix, run in (("inv", se2_invariant_ekf_runs), ("std", se2_standard_ekf_runs)):
+        terms = _curve_terms(truth, run(model, y, T0, P0, u))
+        mse = terms["position_mse"].reshape(len(keys), M, K).mean(axis=1)
+        nees = terms["position_nees"].reshape(len(keys), M, K).mean(axis=1)
+        for j, key in enumerate(keys):
+            runs[key].update({
+                f"{prefix}_nees": nees[j, pick], f"{prefix}_rmse": np.sqrt(mse[j, pick]),
+                f"{prefix}_nees_mean": np.array([nees[j, SLIDER_FROM:].mean()]),
+                f"{prefix}_rmse_mean": np.array([np.sqrt(mse[j].mean())]),
+            })
+    return SliderStudy(float(odometry_scale), dt * np.arange(1, K + 1)[pick], runs)
