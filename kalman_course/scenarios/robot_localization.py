@@ -36,7 +36,8 @@ __all__ = [
     "HEADING_STD", "NEES_FROM", "CHUNK", "UKFM_TABLE",
     "localization_model", "true_poses", "LocalizationData", "localization_data",
     "FilterScores", "LocalizationBenchmark", "LocalizationCurves", "localization_curves",
-    "localization_benchmark", "heading_independence", "tiny_error_agreement",
+    "localization_benchmark", "heading_independence", "tiny_error_agreement", "ukfm_noise_model",
+    "SliderStudy", "slider_study", "TwoHeadings", "two_headings",
 ]
 
 #: Période de l'odométrie (s) et nombre d'instants (40 s).
@@ -249,17 +250,11 @@ def localization_benchmark(n_runs: int = 100, *, rng: Any) -> LocalizationBenchm
     return LocalizationBenchmark(curves.n_runs, curves.scores("invariant"), curves.scores("standard"))
 
 
-def heading_independence(headings_deg=(0.0, 90.0), n_instants: int = N_INSTANTS, rng: Any = 35) -> float:
-    r"""Écart maximal entre les covariances :math:`P` de l'EKF invariant lancé sur les mêmes données depuis des
-    caps initiaux différents (``headings_deg``) : nul à l'arrondi près, car :math:`F`, :math:`G`, :math:`H` ne
-    dépendent que de l'odométrie."""
-    data = localization_data(1, rng=rng, n_instants=n_instants)
-    Ps = []
-    for deg in headings_deg:
-        a = np.radians(deg)
-        T0 = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
-        Ps.append(se2_invariant_ekf_runs(data.model, data.y, T0, data.P0, data.u).P[0])
-    return float(max(np.max(np.abs(P - Ps[0])) for P in Ps[1:]))
+def heading_independence(headings_deg=(0.0, 90.0), rng: int = 35) -> float:
+    r"""Écart maximal entre les covariances :math:`P` de l'EKF invariant lancé sur les mêmes données (un tirage du
+    banc d'essai) depuis des caps initiaux différents (``headings_deg``) : nul à l'arrondi près, car :math:`F`,
+    :math:`G`, :math:`H` ne dépendent que de l'odométrie (:func:`two_headings`)."""
+    return two_headings(tuple(float(h) for h in headings_deg), rng).invariant_gap
 
 
 @lru_cache(maxsize=8)
@@ -352,3 +347,44 @@ def slider_study(odometry_scale: float) -> SliderStudy:
                 f"{prefix}_rmse_mean": np.array([np.sqrt(mse[j].mean())]),
             })
     return SliderStudy(float(odometry_scale), dt * np.arange(1, K + 1)[pick], runs)
+
+
+# --------------------------------------------------------------------------- deux caps initiaux
+
+
+@dataclass(frozen=True, eq=False)
+class TwoHeadings:
+    r"""Un tirage du banc d'essai filtré depuis deux caps initiaux (``headings_deg``, la position de départ
+    étant juste), avec la même :math:`P_0` : ``invariant[i]`` et ``standard[i]`` sont les
+    :class:`~kalman_course.SE2FilterResult` du cap ``headings_deg[i]`` ; ``data`` : les données."""
+
+    headings_deg: tuple
+    data: LocalizationData
+    invariant: tuple
+    standard: tuple
+
+    @property
+    def invariant_gap(self) -> float:
+        """Écart maximal entre les covariances :math:`P` de l'EKF invariant des différents caps."""
+        return float(max(np.max(np.abs(r.P - self.invariant[0].P)) for r in self.invariant[1:]))
+
+    @property
+    def standard_gap(self) -> float:
+        """Le même écart pour l'EKF standard."""
+        return float(max(np.max(np.abs(r.P - self.standard[0].P)) for r in self.standard[1:]))
+
+
+@lru_cache(maxsize=4)
+def two_headings(headings_deg: tuple = (0.0, 60.0), rng: int = SLIDER_SEED) -> TwoHeadings:
+    """Le tirage ``rng`` du banc d'essai (vérité de cap nul), filtré par les deux filtres depuis chacun des caps
+    ``headings_deg`` (°), avec :math:`P_0 = \\mathrm{diag}(0, 0, (45°)^2)`."""
+    from ..filters.invariant import se2_invariant_ekf, se2_standard_ekf
+
+    data = localization_data(1, rng=rng)
+    inv, std = [], []
+    for deg in headings_deg:
+        a = np.radians(deg)
+        T0 = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+        inv.append(se2_invariant_ekf(data.model, data.y[0], T0, data.P0, data.u[0]))
+        std.append(se2_standard_ekf(data.model, data.y[0], T0, data.P0, data.u[0]))
+    return TwoHeadings(tuple(headings_deg), data, tuple(inv), tuple(std))
