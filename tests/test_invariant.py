@@ -425,3 +425,18 @@ def test_model_is_frozen_with_its_covariances():
         m.dt = 0.1
     with pytest.raises(ValueError):
         m.Q[0, 0] = 1.0
+
+
+def test_runs_name_the_bad_prior_of_one_run():
+    args = _args()
+    T0s = np.stack([args["T0"]] * 3)
+    T0s[1, 2, 2] = 2.0
+    P0s = np.stack([args["P0"]] * 3)
+    P0s[2] = -np.eye(3)
+    Y, U = np.stack([args["y"]] * 3), args["u"]
+    with pytest.raises(kc.KalmanInputError, match=r"« T0\[1\] » n'est pas une pose plane"):
+        kc.se2_invariant_ekf_runs(args["model"], Y, T0s, args["P0"], U)
+    with pytest.raises(kc.KalmanInputError, match=r"« P0\[2\] » doit être semi-définie positive"):
+        kc.se2_standard_ekf_runs(args["model"], Y, args["T0"], P0s, U)
+    with pytest.raises(kc.KalmanInputError, match=r"« P0 » doit être de forme \(3, 3\) \(commune\) ou \(3, 3, 3\)"):
+        kc.se2_standard_ekf_runs(args["model"], Y, args["T0"], P0s[:2], U)

@@ -115,6 +115,13 @@ def test_jacobians_match_their_integral(xi):
     assert np.max(np.abs(Jl - kc.se2_adjoint(expm(xi)) @ Jr)) <= TOL * scale ** 2  # J_l = Ad_Exp(ξ) J_r
 
 
+def test_exponential_in_a_batch_is_the_exponential_of_each_row():
+    xis = np.array(TANGENTS)
+    batch = lie._se2_exp_many(xis)
+    for xi, T in zip(xis, batch):
+        assert np.max(np.abs(T - kc.se2_exp(xi))) <= 1e-15 * max(1.0, np.linalg.norm(xi))
+
+
 def test_taylor_thresholds_are_continuous():
     """De part et d'autre des seuils, la branche de Taylor et la forme close se rejoignent à l'arrondi près."""
     rho = np.array([3.0, -4.0])

@@ -55,7 +55,7 @@ from ..core.validation import (
     number_text,
     shape_text,
 )
-from ..geometry.lie import _se2_exp, as_se2_pose
+from ..geometry.lie import ROTATION_TOL, _se2_exp, _se2_exp_many, as_se2_pose
 from .engine import Correction, FilterFamily, gaussian_moments, run_filter, run_filter_runs
 from .gating import fading_factor, gate_probability, gate_threshold, nis_value
 
@@ -456,7 +456,7 @@ def _batch_update(kind, model, T, P, Y):
     K = np.swapaxes(np.linalg.solve(S, P[:, :2, :]), 1, 2)
     dx = np.einsum("nij,nj->ni", K, z)
     if kind == "invariant":
-        T_new = T @ np.array([_se2_exp(v) for v in dx])
+        T_new = T @ _se2_exp_many(dx)
     else:
         c, s = np.cos(dx[:, 2]), np.sin(dx[:, 2])
         E = np.zeros_like(T)
@@ -470,9 +470,10 @@ def _batch_update(kind, model, T, P, Y):
 # --------------------------------------------------------------------------- familles et filtres
 
 
-def _per_run(name: str, value: Any, N: int, check) -> np.ndarray:
+def _per_run(name: str, value: Any, N: int, check, fine) -> np.ndarray:
     """``value`` (3, 3) commune à tous les tirages ou (N, 3, 3) une par tirage, chacune vérifiée par
-    ``check(nom, matrice)`` ; renvoie (N, 3, 3)."""
+    ``check(nom, matrice)`` ; ``fine(pile)`` dit, en bloc, quelles matrices passent sans examen (les autres
+    passent par ``check``, qui lève l'erreur qui les nomme). Renvoie (N, 3, 3)."""
     arr = as_float_array(name, value)
     if arr.ndim != 3:
         return np.broadcast_to(check(name, arr), (N, 3, 3)).copy()
@@ -480,7 +481,28 @@ def _per_run(name: str, value: Any, N: int, check) -> np.ndarray:
         raise KalmanInputError(
             f"« {name} » doit être de forme (3, 3) (commune) ou ({N}, 3, 3) (une par tirage) ; reçu {shape_text(arr.shape)}."
         )
-    return np.stack([check(f"{name}[{i}]", arr[i]) for i in range(N)])
+    ok = fine(arr)
+    out = arr.copy()
+    for i in np.flatnonzero(~ok):
+        out[i] = check(f"{name}[{i}]", arr[i])
+    return out
+
+
+def _fine_poses(T: np.ndarray) -> np.ndarray:
+    """Poses planes valides (dernière ligne, rotation), en bloc : même tolérance que :func:`as_se2_pose`."""
+    R = T[:, :2, :2]
+    err = np.abs(np.swapaxes(R, 1, 2) @ R - np.eye(2)).max(axis=(1, 2))
+    det = R[:, 0, 0] * R[:, 1, 1] - R[:, 0, 1] * R[:, 1, 0]
+    last = np.abs(T[:, 2] - [0.0, 0.0, 1.0]).max(axis=1)
+    return (err <= ROTATION_TOL) & (np.abs(det - 1.0) <= ROTATION_TOL) & (last <= ROTATION_TOL)
+
+
+def _fine_covariances(P: np.ndarray) -> np.ndarray:
+    """Covariances symétriques et semi-définies positives, en bloc : mêmes tolérances que :func:`check_psd`."""
+    scale = np.maximum(1.0, np.abs(P).max(axis=(1, 2)))
+    sym = np.abs(P - np.swapaxes(P, 1, 2)).max(axis=(1, 2)) <= 1e-9 * scale
+    lam = np.linalg.eigvalsh(0.5 * (P + np.swapaxes(P, 1, 2)))[:, 0]
+    return sym & (lam >= -1e-10 * scale)
 
 
 def _check_kind(kind: Any) -> str:
@@ -517,8 +539,8 @@ def se2_family(kind: str = "invariant", *, gate: Any = None, fading: Any = None)
         return _correct(kind, T, P, z, K), Correction(K, z, S)
 
     def prior_many(model, T0, P0, N, shared=False):
-        return (_per_run("T0", T0, N, as_se2_pose),
-                _per_run("P0", P0, N, lambda name, M: check_psd(name, as_square_matrix(name, M, 3))))
+        P = _per_run("P0", P0, N, lambda name, M: check_psd(name, as_square_matrix(name, M, 3)), _fine_covariances)
+        return _per_run("T0", T0, N, as_se2_pose, _fine_poses), 0.5 * (P + np.swapaxes(P, 1, 2))
 
     def predict_many(model, state, u, k):
         return _batch_predict(kind, model, state[0], state[1], u)

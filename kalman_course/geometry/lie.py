@@ -444,6 +444,24 @@ def _se2_exp(xi: np.ndarray) -> np.ndarray:
     return np.array([[c, -s, A * rx - B * ry], [s, c, B * rx + A * ry], [0.0, 0.0, 1.0]])
 
 
+def _se2_exp_many(xi: np.ndarray) -> np.ndarray:
+    r""":func:`se2_exp` de chaque ligne de ``xi`` (N, 3) → (N, 3, 3), en bloc (mêmes formules, même branche de
+    Taylor sous :data:`SMALL_ANGLE`)."""
+    t = xi[:, 2]
+    small = np.abs(t) < SMALL_ANGLE
+    ts = np.where(small, 1.0, t)
+    t2 = t * t
+    h = np.sin(0.5 * t)
+    A = np.where(small, 1.0 - t2 / 6.0 + t2 * t2 / 120.0, np.sin(t) / ts)
+    B = np.where(small, t * (0.5 - t2 / 24.0 + t2 * t2 / 720.0), 2.0 * h * h / ts)
+    c, s = np.cos(t), np.sin(t)
+    T = np.zeros((xi.shape[0], 3, 3))
+    T[:, 0, 0], T[:, 0, 1], T[:, 0, 2] = c, -s, A * xi[:, 0] - B * xi[:, 1]
+    T[:, 1, 0], T[:, 1, 1], T[:, 1, 2] = s, c, B * xi[:, 0] + A * xi[:, 1]
+    T[:, 2, 2] = 1.0
+    return T
+
+
 def _se2_log(T: np.ndarray) -> np.ndarray:
     t = float(np.arctan2(T[1, 0], T[0, 0]))
     if t <= -np.pi:  # atan2(−0, −1) = −π : on rend π, dans (−π, π]

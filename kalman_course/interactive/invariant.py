@@ -1,9 +1,9 @@
 r"""Curseurs du chapitre « Filtrage invariant sur les groupes de Lie » : le robot plan, odométrie et GNSS.
 
 Trois curseurs : l'écart-type :math:`\sigma_0` de l'erreur initiale de cap (0° à 90°), la période du GNSS
-(0,5 s à 2 s) et le bruit de l'odométrie (0,3 à 3 fois celui du banc d'essai). Deux panneaux : la NEES de
+(0,4 s à 2 s) et le bruit de l'odométrie (0,3 à 3 fois celui du banc d'essai). Deux panneaux : la NEES de
 position moyenne et l'erreur quadratique moyenne de position de l'EKF invariant et de l'EKF standard au
-cours du temps (:func:`~kalman_course.scenarios.robot_localization.slider_study` : odométrie à 10 Hz,
+cours du temps (:func:`~kalman_course.scenarios.robot_localization.slider_study` : odométrie à 5 Hz,
 8 tirages par position, erreurs initiales de cap aux quantiles de la loi normale). Position par défaut :
 45°, 1 s, bruit du banc d'essai.
 """
@@ -67,7 +67,7 @@ def invariant_spec() -> SliderSpec:
     return SliderSpec(
         name="invariant-curseurs",
         chapter=CHAPTER,
-        title=(f"Robot plan, odométrie à 10 Hz et GNSS à 1 m : EKF invariant et EKF standard "
+        title=(f"Robot plan, odométrie à 5 Hz et GNSS à 1 m : EKF invariant et EKF standard "
                f"({rl.SLIDER_RUNS} tirages par position)"),
         x_label="temps (s)",
         axes=invariant_axes(),
