@@ -592,13 +592,13 @@ def test_tutorial_three_answers_are_the_package_values():
     assert "= 40/49$" in text
 
 
-def test_tutorial_four_answers_are_the_package_values():
-    """TD 4 : Exp(1, 0, π/2), l'adjointe de la pose (90°, (3, 1)) et la correction de l'EKF invariant, écrites à
+def test_tutorial_invariant_answers_are_the_package_values():
+    """TD 6 : Exp(1, 0, π/2), l'adjointe de la pose (90°, (3, 1)) et la correction de l'EKF invariant, écrites à
     la main dans la page, contre le paquet (kc.se2_exp, kc.se2_adjoint, se2_invariant_update) et contre des
     calculs indépendants écrits ici (scipy.linalg.expm, formule de Kalman)."""
     import scipy.linalg
 
-    text = _page("td-pour-aller-plus-loin")
+    text = _page("td-filtrage-invariant")
     hand = kc.scenarios.tutorials.se2_by_hand()
     r = 2 / np.pi
     exp_hand = np.array([[0, -1, r], [1, 0, r], [0, 0, 1.0]])

@@ -47,7 +47,7 @@ CHAPTER_TITLES: dict[str, str] = {
     "quel-filtre": "Quel filtre choisir ?",
     "filtrage-parallele": "Filtrer en parallèle dans le temps",
     "filtrage-invariant": "Filtrage invariant sur les groupes de Lie",
-    "td-pour-aller-plus-loin": "TD 4 — Pour aller plus loin : l'EKF invariant à la main",
+    "td-filtrage-invariant": "TD 6 — L'EKF invariant à la main",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

@@ -15,7 +15,7 @@ import numpy as np
 from ..scenarios import robot_localization as rl
 from .figure import SliderSpec, number, register_sliders
 from .grid import ParameterAxis
-from .spec import Glyph, Panel
+from .spec import Follow, Glyph, Panel
 
 __all__ = ["NEES_CAP", "invariant_axes", "invariant_run", "invariant_spec"]
 
@@ -54,7 +54,7 @@ def invariant_run(heading_std: float, gnss_period: float, odometry_scale: float)
 
 def _readout(series, values) -> str:
     h, period, scale = values
-    return (f"σ₀ = {number(h)}°, une position GNSS toutes les {number(period, 's')}, odométrie × {number(scale)} : "
+    return (f"σ₀ = {number(h)}°, période du GNSS {number(period, 's')}, odométrie × {number(scale)} : "
             f"NEES de position moyenne après 20 s — EKF invariant {number(series['inv_nees_mean'][0])}, "
             f"EKF standard {number(series['std_nees_mean'][0])} ; erreur de position (RMSE) — "
             f"{number(series['inv_rmse_mean'][0], 'm')} et {number(series['std_rmse_mean'][0], 'm')}.")
@@ -77,14 +77,14 @@ def invariant_spec() -> SliderSpec:
         panels=(
             Panel("NEES de position moyenne (1 : filtre cohérent ; plafonnée à 10⁶)", "NEES (sans unité)",
                   (Glyph("one", "line", "black", "1 : filtre cohérent", width=1.0),
-                   Glyph("one", "vline", "gray", "début des moyennes (20 s)", value=20.0, dash="dotted", width=1.0),
+                   Glyph("one", "vline", "gray", "20 s", value=20.0, dash="dotted", width=1.0),
                    Glyph("inv_nees", "line", "royalblue", "EKF invariant"),
                    Glyph("std_nees", "line", "crimson", "EKF standard", dash="dashed")),
                   y_log=True, y_range=(1e-2, 2 * NEES_CAP), height=250),
             Panel("Erreur quadratique moyenne de position", "erreur (m)",
                   (Glyph("inv_rmse", "line", "royalblue", "EKF invariant"),
                    Glyph("std_rmse", "line", "crimson", "EKF standard", dash="dashed")),
-                  y_range=(0.0, 6.0), height=230),
+                  y_range=Follow(include=(0.0,)), height=230),
         ),
         readout=_readout,
     )

@@ -252,7 +252,7 @@ def _update_cases() -> list[Case]:
         _update_case("cap de 60°, petite correction d'angle", np.pi / 3, [2.0, 1.0], spd(rng, 3, 0.1),
                      [2.3, 1.4], 1.0),
         _update_case("cap de 170°, grande correction d'angle", np.radians(170.0), [-3.0, 4.0], P1, [-5.0, 2.0], 0.5),
-        _update_case("le TD 4 : cap 90°, correction de 90°", np.pi / 2, [3.0, 1.0],
+        _update_case("le TD 6 : cap 90°, correction de 90°", np.pi / 2, [3.0, 1.0],
                      np.array([[1.0, 0.0, np.pi / 2], [0.0, 1.0, 0.0], [np.pi / 2, 0.0, 4.0]]), [3.0, 3.0], 1.0),
         _update_case("cap de −2 rad, GNSS précis (σ = 0,1 m)", -2.0, [10.0, -5.0], spd(rng, 3, 2.0),
                      [10.5, -4.2], 0.1),

@@ -13,7 +13,7 @@ et les tests (qui comparent les deux).
   perturbation des observations ;
 * :func:`three_step_smoothing` — TD 3 : trois pas de filtre et de lisseur RTS sur une marche aléatoire,
   puis l'étape M de R ;
-* :func:`se2_by_hand` — TD 4 : une exponentielle et une adjointe de SE(2), puis une correction de l'EKF
+* :func:`se2_by_hand` — TD 6 : une exponentielle et une adjointe de SE(2), puis une correction de l'EKF
   invariant.
 """
 
@@ -132,7 +132,7 @@ def three_step_smoothing() -> ThreeSteps:
                       sm.P[:, 0, 0], sm.G[:-1, 0, 0], float(new.R[0, 0]))
 
 
-#: TD 4 : le vecteur tangent ξ de l'exponentielle, la pose prédite T̂ (cap 90°, position (3, 1)), sa covariance
+#: TD 6 : le vecteur tangent ξ de l'exponentielle, la pose prédite T̂ (cap 90°, position (3, 1)), sa covariance
 #: P⁻ (erreur invariante à gauche ξ = [ρₓ, ρ_y, θ]), la position GNSS y et son écart-type σ.
 SE2_BY_HAND = {
     "xi": (1.0, 0.0, np.pi / 2),
@@ -145,7 +145,7 @@ SE2_BY_HAND = {
 
 @dataclass(frozen=True)
 class SE2ByHand:
-    """TD 4 : ``exp`` = Exp(ξ) (3, 3), ``adjoint`` = Ad de T̂ (3, 3), et la correction de l'EKF invariant
+    """TD 6 : ``exp`` = Exp(ξ) (3, 3), ``adjoint`` = Ad de T̂ (3, 3), et la correction de l'EKF invariant
     (:class:`~kalman_course.filters.invariant.SE2Update` : ``T``, ``P``, ``K``, ``innovation``, ``S``)."""
 
     exp: np.ndarray
@@ -154,7 +154,7 @@ class SE2ByHand:
 
 
 def se2_by_hand() -> SE2ByHand:
-    """Les calculs du TD 4 par le paquet : :func:`~kalman_course.se2_exp`, :func:`~kalman_course.se2_adjoint`
+    """Les calculs du TD 6 par le paquet : :func:`~kalman_course.se2_exp`, :func:`~kalman_course.se2_adjoint`
     et :func:`~kalman_course.filters.invariant.se2_invariant_update`."""
     from ..filters.invariant import se2_invariant_update
     from ..geometry.lie import se2_adjoint, se2_exp
