@@ -106,6 +106,8 @@ def test_hidden_cases_vary_sizes_and_cover_the_announced_difficulties():
         assert len(cases) >= 4, ex.id
         if ex.id == "so3-exp":  # une rotation est toujours (3,) : les cas varient l'angle (0, 10⁻⁹, π…)
             continue
+        if ex.id.startswith("se2-"):  # SE(2) : toujours des poses (3, 3) ; les cas varient les angles
+            continue
         shapes = {tuple(np.shape(a) for a in c.args if isinstance(a, np.ndarray)) for c in cases}
         assert len(shapes) >= 3, f"{ex.id} : les cas cachés ont presque tous les mêmes tailles"
 
@@ -239,6 +241,39 @@ def so3_exp(omega):
     k = omega / theta
     K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     return np.eye(3) + np.sin(theta) * K + (1 - np.cos(theta)) * K @ K
+"""),
+    ("se2-exp", "v-forgotten", "T[:2, 2] = xi[:2]", """\
+def se2_exp(xi):
+    c, s = np.cos(xi[2]), np.sin(xi[2])
+    T = np.eye(3)
+    T[:2, :2] = [[c, -s], [s, c]]
+    T[:2, 2] = xi[:2]
+    return T
+"""),
+    ("se2-invariant-predict", "adjoint-not-inverted", "F = adjoint(U)", """\
+def predict(T, P, u, dt, Q):
+    def adjoint(M):
+        A = np.eye(3)
+        A[:2, :2] = M[:2, :2]
+        A[:2, 2] = [M[1, 2], -M[0, 2]]
+        return A
+    a = u[2] * dt
+    U = np.array([[np.cos(a), -np.sin(a), u[0] * dt], [np.sin(a), np.cos(a), u[1] * dt], [0, 0, 1]])
+    F = adjoint(U)
+    G = dt * np.eye(3)
+    G[:2, :2] = dt * U[:2, :2].T
+    return T @ U, F @ P @ F.T + G @ Q @ G.T
+"""),
+    ("se2-invariant-update", "world-innovation", "z = y - T_pred[:2, 2]", """\
+def update(T_pred, P_pred, y, gnss_std):
+    from scipy.linalg import expm
+    z = y - T_pred[:2, 2]
+    H = np.hstack([np.eye(2), np.zeros((2, 1))])
+    S = H @ P_pred @ H.T + gnss_std**2 * np.eye(2)
+    K = P_pred @ H.T @ np.linalg.inv(S)
+    d = K @ z
+    T = T_pred @ expm(np.array([[0, -d[2], d[0]], [d[2], 0, d[1]], [0, 0, 0]]))
+    return T, (np.eye(3) - K @ H) @ P_pred
 """),
     ("tag-jacobian", "sign", "", """\
 def ranges_jacobian(x, anchors):
@@ -561,6 +596,53 @@ def test_tutorial_three_answers_are_the_package_values():
     assert steps.xs[2] == pytest.approx(43 / 21) and steps.Ps[2] == pytest.approx(13 / 21)
     assert _fractions(text, "R'")[-1] == pytest.approx(steps.R_new, abs=1e-14)
     assert "= 40/49$" in text
+
+
+def test_tutorial_invariant_answers_are_the_package_values():
+    """TD 6 : Exp(1, 0, π/2), l'adjointe de la pose (90°, (3, 1)) et la correction de l'EKF invariant, écrites à
+    la main dans la page, contre le paquet (kc.se2_exp, kc.se2_adjoint, se2_invariant_update) et contre des
+    calculs indépendants écrits ici (scipy.linalg.expm, formule de Kalman)."""
+    import scipy.linalg
+
+    text = _page("td-filtrage-invariant")
+    hand = kc.scenarios.tutorials.se2_by_hand()
+    r = 2 / np.pi
+    exp_hand = np.array([[0, -1, r], [1, 0, r], [0, 0, 1.0]])
+    hat = np.array([[0, -np.pi / 2, 1.0], [np.pi / 2, 0, 0], [0, 0, 0]])
+    np.testing.assert_allclose(hand.exp, exp_hand, atol=1e-15)
+    np.testing.assert_allclose(scipy.linalg.expm(hat), exp_hand, atol=1e-13)
+    assert r"V(\pi/2)\rho = (2/\pi,\ 2/\pi) \approx (0{,}637 ;\ 0{,}637)" in text
+    assert r"\begin{bmatrix} 0 & -1 & 2/\pi \\ 1 & 0 & 2/\pi \\ 0 & 0 & 1 \end{bmatrix}" in text
+    ad_hand = np.array([[0, -1, 1], [1, 0, -3], [0, 0, 1.0]])
+    np.testing.assert_array_equal(hand.adjoint, ad_hand)
+    assert r"\mathrm{Ad}_{\hat T} = \begin{bmatrix} 0 & -1 & 1 \\ 1 & 0 & -3 \\ 0 & 0 & 1 \end{bmatrix}" in text
+    eps = 1e-3  # Ad δ = (ε, −3ε, ε) : la rotation d'angle ε autour de la position (3, 1)
+    np.testing.assert_allclose(hand.adjoint @ [0, 0, eps], [eps, -3 * eps, eps], atol=1e-18)
+    assert r"(\varepsilon, -3\varepsilon, \varepsilon)" in text
+    up = hand.update
+    c = kc.scenarios.tutorials.SE2_BY_HAND
+    P, H = np.array(c["P_pred"]), np.hstack([np.eye(2), np.zeros((2, 1))])
+    K = P @ H.T @ np.linalg.inv(H @ P @ H.T + np.eye(2))
+    np.testing.assert_allclose(up.innovation, [2.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(up.S, 2 * np.eye(2), atol=1e-15)
+    np.testing.assert_allclose(up.K, [[0.5, 0], [0, 0.5], [np.pi / 4, 0]], atol=1e-15)
+    np.testing.assert_allclose(up.K, K, atol=1e-15)
+    np.testing.assert_allclose(up.K @ up.innovation, [1.0, 0.0, np.pi / 2], atol=1e-15)
+    assert "$z = (2, 0)$" in text and "$Kz = (1, 0, \\pi/2)$" in text
+    np.testing.assert_allclose(up.T[:2, :2], -np.eye(2), atol=1e-15)  # cap 180°
+    np.testing.assert_allclose(up.T[:2, 2], [3 - r, 1 + r], atol=1e-14)
+    assert "(3 - 2/\\pi,\\ 1 + 2/\\pi) \\approx (2{,}363 ;\\ 1{,}637)" in text and "cap **180°**" in text
+    assert f"{3 - r:.3f}" == "2.363" and f"{1 + r:.3f}" == "1.637"
+    P_plus = np.array([[0.5, 0, np.pi / 4], [0, 0.5, 0], [np.pi / 4, 0, 4 - np.pi**2 / 8]])
+    np.testing.assert_allclose(up.P, P_plus, atol=1e-14)
+    np.testing.assert_allclose(up.P, (np.eye(3) - K @ H) @ P, atol=1e-14)
+    assert "4 - \\pi^2/8 \\approx 2{,}766" in text and f"{4 - np.pi**2 / 8:.3f}" == "2.766"
+    # question 5 : tourner le monde ne change ni z, ni K, ni P₊
+    g = kc.se2_exp([0.0, 0.0, 0.7])
+    turned = kc.filters.invariant.se2_invariant_update(g @ np.array(c["T_pred"]), P, g[:2, :2] @ np.array(c["y"]), 1.0)
+    for field in ("innovation", "K", "P"):
+        np.testing.assert_allclose(getattr(turned, field), getattr(up, field), atol=1e-12)
+    np.testing.assert_allclose(turned.T, g @ up.T, atol=1e-12)
 
 
 # --------------------------------------------------------------------------- carnets de l'étudiant

@@ -46,6 +46,8 @@ CHAPTER_TITLES: dict[str, str] = {
     "filtre-gaussien": "Un seul filtre gaussien : linéarisation, points sigma, cubature, Gauss–Hermite",
     "quel-filtre": "Quel filtre choisir ?",
     "filtrage-parallele": "Filtrer en parallèle dans le temps",
+    "filtrage-invariant": "Filtrage invariant sur les groupes de Lie",
+    "td-filtrage-invariant": "TD 6 — L'EKF invariant à la main",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

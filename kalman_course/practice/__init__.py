@@ -29,6 +29,7 @@ from typing import Any, Callable, NamedTuple
 from .grading import Case, Exercise, Mistake, Output, grade
 from .linear import JOSEPH_UPDATE, KF_PREDICT, KF_UPDATE, NIS
 from .nonlinear import EKF_UPDATE, SO3_EXP, TAG_JACOBIAN
+from .invariant import SE2_EXP, SE2_INVARIANT_PREDICT, SE2_INVARIANT_UPDATE
 from .sampling import PARTICLE_WEIGHTS, SIGMA_POINTS, SYSTEMATIC_RESAMPLE, UNSCENTED_TRANSFORM
 from .smoothing import EM_M_STEP, RTS_STEP
 from .verdict import Verdict
@@ -38,7 +39,7 @@ __all__ = ["Attempt", "Case", "Exercise", "Mistake", "Output", "Verdict", "attem
 
 _EXERCISES: tuple[Exercise, ...] = (
     KF_PREDICT, KF_UPDATE, JOSEPH_UPDATE, NIS,
-    EKF_UPDATE, TAG_JACOBIAN, SO3_EXP,
+    EKF_UPDATE, TAG_JACOBIAN, SO3_EXP, SE2_EXP, SE2_INVARIANT_PREDICT, SE2_INVARIANT_UPDATE,
     SIGMA_POINTS, UNSCENTED_TRANSFORM, SYSTEMATIC_RESAMPLE, PARTICLE_WEIGHTS,
     RTS_STEP, EM_M_STEP,
 )

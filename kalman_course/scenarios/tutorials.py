@@ -12,7 +12,9 @@ et les tests (qui comparent les deux).
 * :func:`ensemble_spread` — TD 2 : la dispersion de l'analyse d'un EnKF scalaire, avec et sans
   perturbation des observations ;
 * :func:`three_step_smoothing` — TD 3 : trois pas de filtre et de lisseur RTS sur une marche aléatoire,
-  puis l'étape M de R.
+  puis l'étape M de R ;
+* :func:`se2_by_hand` — TD 6 : une exponentielle et une adjointe de SE(2), puis une correction de l'EKF
+  invariant.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from ..likelihood import em_step
 __all__ = [
     "THERMOMETER", "SQUARE_UT", "FOUR_WEIGHTS", "FOUR_U", "ENSEMBLE_EXAMPLE", "THREE_STEPS",
     "thermometer_update", "square_transform", "four_particles", "ensemble_spread", "three_step_smoothing",
+    "SE2_BY_HAND", "SE2ByHand", "se2_by_hand",
 ]
 
 #: TD 1 : a priori (°C), sa variance (°C²), mesure (°C), variance de la mesure (°C²).
@@ -127,3 +130,35 @@ def three_step_smoothing() -> ThreeSteps:
     new = em_step(model, y, [c["x0"]], [[c["P0"]]], None)[1]
     return ThreeSteps(res.x[:, 0], res.P[:, 0, 0], res.x_pred[:, 0], res.P_pred[:, 0, 0], sm.x[:, 0],
                       sm.P[:, 0, 0], sm.G[:-1, 0, 0], float(new.R[0, 0]))
+
+
+#: TD 6 : le vecteur tangent ξ de l'exponentielle, la pose prédite T̂ (cap 90°, position (3, 1)), sa covariance
+#: P⁻ (erreur invariante à gauche ξ = [ρₓ, ρ_y, θ]), la position GNSS y et son écart-type σ.
+SE2_BY_HAND = {
+    "xi": (1.0, 0.0, np.pi / 2),
+    "T_pred": ((0.0, -1.0, 3.0), (1.0, 0.0, 1.0), (0.0, 0.0, 1.0)),
+    "P_pred": ((1.0, 0.0, np.pi / 2), (0.0, 1.0, 0.0), (np.pi / 2, 0.0, 4.0)),
+    "y": (3.0, 3.0),
+    "gnss_std": 1.0,
+}
+
+
+@dataclass(frozen=True)
+class SE2ByHand:
+    """TD 6 : ``exp`` = Exp(ξ) (3, 3), ``adjoint`` = Ad de T̂ (3, 3), et la correction de l'EKF invariant
+    (:class:`~kalman_course.filters.invariant.SE2Update` : ``T``, ``P``, ``K``, ``innovation``, ``S``)."""
+
+    exp: np.ndarray
+    adjoint: np.ndarray
+    update: object
+
+
+def se2_by_hand() -> SE2ByHand:
+    """Les calculs du TD 6 par le paquet : :func:`~kalman_course.se2_exp`, :func:`~kalman_course.se2_adjoint`
+    et :func:`~kalman_course.filters.invariant.se2_invariant_update`."""
+    from ..filters.invariant import se2_invariant_update
+    from ..geometry.lie import se2_adjoint, se2_exp
+
+    c = SE2_BY_HAND
+    return SE2ByHand(se2_exp(c["xi"]), se2_adjoint(c["T_pred"]),
+                     se2_invariant_update(c["T_pred"], c["P_pred"], c["y"], c["gnss_std"]))
