@@ -346,10 +346,16 @@ def test_independent_implementations_from_filterpy_pass(monkeypatch):
         return fr.systematic_resample(weights)
 
     for exercise_id, fn in (("kf-predict", predict), ("kf-update", update), ("sigma-points", sigma_points),
-                            ("unscented-transform", unscented_transform),
-                            ("systematic-resample", systematic_resample)):
+                            ("unscented-transform", unscented_transform)):
         verdict = practice.check(exercise_id, fn)
         assert verdict.passed, (exercise_id, verdict.feedback)
+    # filterpy 2.0.0 ne force pas la dernière somme cumulée à 1 : sur le cas caché de l'arrondi (27 poids égaux,
+    # somme cumulée 1 − 8 × 10⁻¹⁶ sous la dernière position), sa boucle sort du tableau. Il passe tous les autres.
+    verdict = practice.check("systematic-resample", systematic_resample)
+    assert not verdict.passed and "IndexError" in verdict.feedback and "(arrondi)" in verdict.feedback
+    for case in practice.exercise("systematic-resample").cases():
+        if "arrondi" not in case.label:
+            assert np.array_equal(systematic_resample(*case.args), case.expected[0]), case.label
 
 
 def test_closed_form_references_agree_with_independent_computations():
@@ -687,3 +693,169 @@ def test_built_lab_page_ran_its_solutions_and_offers_the_student_notebook(built_
     downloaded = (built_book / "book" / link.group(1)).resolve()
     assert downloaded.read_bytes() == (BOOK / "travaux-pratiques" / f"{page}.ipynb").read_bytes()
     assert 'class="solution dropdown' in html
+
+
+# --------------------------------------------------------------------------- issue 34 : faux succès, indices trompeurs
+
+
+def test_so3_hidden_angles_cover_every_regime_and_refuse_a_wide_small_angle_branch():
+    """« if θ < 0,3 : return I » passait (angles cachés 0, 10⁻⁹ puis 0,37 rad) : les cas couvrent maintenant
+    les petits (10⁻⁵, 0,05), moyens, grands angles et au-delà de π ; une branche petit angle fausse n'est pas
+    prise pour une erreur de la formule générale."""
+    thetas = sorted(c.info["theta"] for c in nonlinear.SO3_EXP.cases())
+    assert thetas[0] == 0.0 and any(1e-6 < t < 1e-3 for t in thetas) and any(1e-2 < t < 0.1 for t in thetas)
+    assert any(0.9 < t < 1.1 for t in thetas) and any(t > np.pi for t in thetas)
+    rodrigues = """\
+def so3_exp(omega):
+    theta = np.linalg.norm(omega)
+    if theta < {threshold}:
+        return {small}
+    k = omega / theta
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(theta) * K + (1 - np.cos(theta)) * K @ K
+"""
+    hat = "np.array([[0, -omega[2], omega[1]], [omega[2], 0, -omega[0]], [-omega[1], omega[0], 0]])"
+    assert practice.check("so3-exp", cell(rodrigues.format(threshold=1e-8, small=f"np.eye(3) + {hat}"), "so3_exp")).passed
+    assert practice.check("so3-exp", cell(rodrigues.format(threshold=1e-3, small=f"np.eye(3) + {hat}"), "so3_exp")).passed
+    wide = practice.check("so3-exp", cell(rodrigues.format(threshold=0.3, small="np.eye(3)"), "so3_exp"))
+    assert not wide.passed and "petit angle" in wide.feedback
+    # une branche petit angle de signe faux : la formule de Rodrigues est juste ailleurs, aucune erreur
+    # classique de la formule générale (« axe non normé », « rotation inverse ») n'est invoquée
+    sign = practice.check("so3-exp", cell(rodrigues.format(threshold=1e-3, small=f"np.eye(3) - {hat}"), "so3_exp"))
+    assert not sign.passed and sign.mistake is None and "presque nul" in sign.feedback, sign.feedback
+    assert sign.line == 4, sign.feedback  # la branche qui a rendu la main, pas la formule de Rodrigues
+
+
+def test_systematic_resampling_has_the_rounding_case_and_names_the_forgotten_last_cumulative_weight():
+    labels = [c.label for c in sampling.SYSTEMATIC_RESAMPLE.cases()]
+    rounding = next(c for c in sampling.SYSTEMATIC_RESAMPLE.cases() if "arrondi" in c.label)
+    w, u = rounding.args
+    assert np.cumsum(w)[-1] < (u + w.size - 1) / w.size < 1.0  # la dernière position dépasse la somme cumulée
+    assert len(labels) >= 7
+    naive = """\
+def systematic_resample(weights, u):
+    N = len(weights)
+    positions = (u + np.arange(N)) / N
+    c = np.cumsum(weights)
+    return np.searchsorted(c, positions, side="right")
+"""
+    verdict = practice.check("systematic-resample", cell(naive, "systematic_resample"))
+    assert verdict.mistake == "last-cumsum" and verdict.line == 4, verdict.feedback
+
+
+def test_one_based_positions_are_not_reported_as_u_plus_i_over_n():
+    """Sur le cas du TD (quatre particules), i = 1…N et u + i/N donnent les mêmes indices (une fois bornés) :
+    le correcteur choisit l'erreur qui explique tous les cas."""
+    source = """\
+def systematic_resample(weights, u):
+    N = len(weights)
+    positions = (u + np.arange(1, N + 1)) / N
+    c = np.cumsum(weights)
+    c[-1] = 1.0
+    return np.minimum(np.searchsorted(c, positions, side="right"), N - 1)
+"""
+    verdict = practice.check("systematic-resample", cell(source, "systematic_resample"))
+    assert verdict.mistake == "one-based", verdict.feedback
+    assert verdict.line == 3
+
+
+def test_a_correct_line_is_never_named_for_a_mistake_made_elsewhere():
+    """« S = C P Cᵀ + R » juste, mais le gain recalcule S sans R : l'erreur est reconnue, la ligne de S n'est
+    pas accusée (aucune ligne n'est nommée quand le correcteur n'est pas sûr)."""
+    source = """\
+def update(x_pred, P_pred, y, C, R):
+    S = C @ P_pred @ C.T + R
+    K = P_pred @ C.T @ np.linalg.inv(C @ P_pred @ C.T)
+    x = x_pred + K @ (y - C @ x_pred)
+    P = (np.eye(len(x_pred)) - K @ C) @ P_pred
+    return x, P
+"""
+    verdict = practice.check("kf-update", cell(source, "update"))
+    assert verdict.mistake == "s-without-r" and verdict.line is None, verdict.feedback
+    assert "S = C @ P_pred @ C.T + R" not in verdict.feedback
+
+
+@pytest.mark.parametrize("source, mistake, line", [
+    ("""\
+def update(x_pred, P_pred, y, C, R):
+    S = C @ P_pred @ C.T + R
+    K = np.linalg.solve(S, C @ P_pred).T
+    x = x_pred + K @ (y - C @ x_pred)
+    P = (np.eye(len(y)) - K @ C) @ P_pred
+    return x, P
+""", "identity-size", 5),
+], ids=["identite-de-la-mesure"])
+def test_wrong_identity_size_is_named_not_a_forgotten_transpose(source, mistake, line):
+    verdict = practice.check("kf-update", cell(source, "update"))
+    assert verdict.mistake == mistake and verdict.line == line, verdict.feedback
+    assert "transposée" not in verdict.feedback
+
+
+def test_jacobian_at_the_corrected_state_is_named():
+    source = """\
+def update(x_pred, P_pred, y, h, H, R):
+    Hp = H(x_pred)
+    S = Hp @ P_pred @ Hp.T + R
+    K = P_pred @ Hp.T @ np.linalg.inv(S)
+    x = x_pred + K @ (y - h(x_pred))
+    P = (np.eye(len(x)) - K @ H(x)) @ P_pred
+    return x, P
+"""
+    verdict = practice.check("ekf-update", cell(source, "update"))
+    assert verdict.mistake == "h-at-corrected" and verdict.line == 6, verdict.feedback
+    assert "transposée" not in verdict.feedback
+
+
+def test_rts_gain_without_the_transpose_after_solve_is_recognised_on_its_line():
+    """L'énoncé du TP 4 prescrit `np.linalg.solve(P_pred, A @ P_filt)` : le `.T` oublié donne Gᵀ, juste en
+    dimension 1 et faux ensuite ; le correcteur le dit sur la ligne du gain."""
+    source = """\
+def rts_step(x_filt, P_filt, x_smooth_next, P_smooth_next, A, Q):
+    P_pred = A @ P_filt @ A.T + Q
+    G = np.linalg.solve(P_pred, A @ P_filt)
+    x_smooth = x_filt + G @ (x_smooth_next - A @ x_filt)
+    P_smooth = P_filt + G @ (P_smooth_next - P_pred) @ G.T
+    return x_smooth, P_smooth
+"""
+    verdict = practice.check("rts-step", cell(source, "rts_step"))
+    assert verdict.mistake == "gain-transposed" and verdict.line == 3, verdict.feedback
+
+
+def test_a_bare_except_around_an_endless_loop_does_not_swallow_the_time_limit(monkeypatch):
+    monkeypatch.setattr(practice.student, "TIME_LIMIT", 0.3)
+    source = """\
+def predict(x, P, A, Q):
+    while True:
+        try:
+            x = A @ x
+        except:
+            pass
+"""
+    start = time.monotonic()
+    verdict = practice.check("kf-predict", cell(source, "predict"))
+    assert time.monotonic() - start < 10
+    assert not verdict.passed and verdict.kind == "temps" and "n'a pas rendu la main" in verdict.feedback
+    swallowed = """\
+def predict(x, P, A, Q):
+    try:
+        while True:
+            pass
+    except BaseException:
+        return A @ x, A @ P @ A.T + Q
+"""
+    verdict = practice.check("kf-predict", cell(swallowed, "predict"))
+    assert not verdict.passed and verdict.kind == "temps"
+
+
+def test_a_lab_figure_blames_the_student_function_not_the_package():
+    """`update` sans `return` : la figure du TP 1 le reproche à la fonction de l'étudiant, sur sa ligne, et
+    jamais à une ligne de `labs.py`."""
+    no_return = cell("def update(x_pred, P_pred, y, C, R):\n    x = x_pred\n", "update")
+    run = kc.scenarios.labs.voltage_lab(update=no_return)
+    assert run.student is None and "labs.py" not in run.message
+    assert "`update`" in run.message and "ne renvoie rien" in run.message and "votre cellule" in run.message
+    fig = kc.figures.draw("tp-tension", update=no_return)
+    assert "labs.py" not in fig._suptitle.get_text() and "ne renvoie rien" in fig._suptitle.get_text()
+    too_big = cell("def update(x_pred, P_pred, y, C, R):\n    return x_pred, np.zeros((2, 2))\n", "update")
+    run = kc.scenarios.labs.voltage_lab(update=too_big)
+    assert run.student is None and "labs.py" not in run.message and "ligne" not in run.message, run.message

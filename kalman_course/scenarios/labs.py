@@ -67,7 +67,8 @@ class LabRun:
 
 
 def _solution(exercise_id: str, fn: Callable | None) -> Callable:
-    return practice.exercise(exercise_id).solution if fn is None else fn
+    """La fonction de l'étudiant (son résultat vérifié à chaque appel), ou la solution de référence."""
+    return practice.exercise(exercise_id).solution if fn is None else practice.validated(exercise_id, fn)
 
 
 def _run(run: Callable[[], dict]) -> tuple[dict | None, str | None]:
