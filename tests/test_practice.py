@@ -10,6 +10,7 @@ fausses documentées par le correcteur et d'autres, écrites ici à la main.
 from __future__ import annotations
 
 import contextlib
+import json
 import linecache
 import os
 import re
@@ -17,6 +18,7 @@ import shutil
 import signal
 import socket
 import subprocess
+import sys
 import time
 import urllib.request
 from fractions import Fraction
@@ -24,19 +26,26 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy
+import scipy.linalg
 import scipy.spatial.transform
 import scipy.stats
 
 import kalman_course as kc
 from kalman_course import practice
 from kalman_course.practice import linear, nonlinear, sampling
-from kalman_course.practice.notebooks import lab_pages, student_notebook, write_student_notebooks
+from kalman_course.practice.notebooks import lab_pages, notebook_name, student_notebook, write_student_notebooks
 
 ROOT = Path(__file__).resolve().parent.parent
 BOOK = ROOT / "book"
 EXERCISES = practice.exercises()
 LAB_PAGES = [p.stem for p in lab_pages(BOOK)]
+#: Les carnets de l'étudiant, dans l'ordre des TP (tp1-… à tp5-…).
+NOTEBOOKS = {page: notebook_name(BOOK / f"{page}.md") for page in LAB_PAGES}
 TUTORIAL_PAGES = sorted(p.stem for p in BOOK.glob("td-*.md"))
+#: Exercices de taille fixée par l'énoncé : une rotation (3,) ; le modèle plan [e, n, v_e, v_n] (4, 4). Leurs cas
+#: varient autre chose (l'angle ; le pas Δt et la densité q).
+FIXED_SIZES = {"so3-exp", "cv-model"}
 
 _CELL = iter(range(10**6))
 
@@ -45,7 +54,7 @@ def cell(source: str, name: str):
     """La fonction ``name`` définie par ``source`` comme dans une cellule de Jupyter."""
     filename = f"/tmp/ipykernel_4242/{next(_CELL)}.py"
     linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
-    namespace = {"np": np}
+    namespace = {"np": np, "scipy": scipy}  # les imports de la première cellule des carnets
     exec(compile(source, filename, "exec"), namespace)  # noqa: S102 — le code de l'étudiant, ici
     return namespace[name]
 
@@ -104,7 +113,7 @@ def test_hidden_cases_vary_sizes_and_cover_the_announced_difficulties():
     for ex in EXERCISES:
         cases = ex.cases()
         assert len(cases) >= 4, ex.id
-        if ex.id == "so3-exp":  # une rotation est toujours (3,) : les cas varient l'angle (0, 10⁻⁹, π…)
+        if ex.id in FIXED_SIZES:  # une rotation est toujours (3,) : les cas varient l'angle (0, 10⁻⁹, π…)
             continue
         shapes = {tuple(np.shape(a) for a in c.args if isinstance(a, np.ndarray)) for c in cases}
         assert len(shapes) >= 3, f"{ex.id} : les cas cachés ont presque tous les mêmes tailles"
@@ -568,7 +577,11 @@ def test_tutorial_three_answers_are_the_package_values():
 
 def test_student_notebooks_follow_the_lab_pages(tmp_path):
     written = write_student_notebooks(BOOK, tmp_path)
-    assert [p.name for p in written] == [f"{page}.ipynb" for page in LAB_PAGES]
+    assert [p.name for p in written] == [NOTEBOOKS[page] for page in LAB_PAGES]
+    # ils se rangent dans l'ordre du cours, TP 1 … TP 5, dans un explorateur de fichiers
+    assert sorted(p.name for p in written) == [p.name for p in written]
+    assert [p.name[:3] for p in written] == [f"tp{k}" for k in range(1, len(written) + 1)]
+    assert sorted(p.name for p in (BOOK / "travaux-pratiques").glob("*.ipynb")) == [p.name for p in written]
     for path in written:
         committed = BOOK / "travaux-pratiques" / path.name
         assert committed.is_file(), f"{committed} manque : python -m kalman_course.practice --notebooks book/travaux-pratiques"
@@ -590,6 +603,29 @@ def test_student_notebook_has_the_blanks_the_checks_and_no_solution(page):
     assert sum("practice.check(" in c for c in code) == len(skeletons)
     assert any("kc.figures.draw(" in c for c in code) and code[0].startswith("import numpy as np")
     assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code")
+
+
+@pytest.mark.parametrize("page", LAB_PAGES)
+def test_student_notebook_text_is_made_for_the_notebook_and_carries_the_quiz(page):
+    """Le carnet ne parle pas du site (« Téléchargez… », blocs repliés, encadré « Comment travailler ») ; sa
+    première cellule dit comment travailler et quoi faire si `import kalman_course` échoue ; le quiz de la
+    page y est, chaque réponse repliée avec son explication."""
+    from test_chapter_pedagogy import quiz_questions
+
+    nb = student_notebook(BOOK / f"{page}.md", BOOK)
+    first = nb.cells[0].source
+    assert nb.cells[0].cell_type == "markdown"
+    assert "import kalman_course" in first and "ModuleNotFoundError" in first and "bash scripts/lab.sh" in first
+    assert kc.practice.wheel_name() in first and "activate" in first
+    rest = "\n".join(c.source for c in nb.cells[1:] if c.cell_type == "markdown")
+    for web_only in ("Téléchargez", "blocs repliés", "solutions sont repliées", "Comment travailler",
+                     "comment-travailler", "sur la page du cours", "ADRESSE-DU-COURS"):
+        assert web_only not in rest, web_only
+    questions = quiz_questions(_page(page))
+    assert rest.count("<details><summary>Réponse</summary>") == len(questions) >= 3
+    for q in questions:
+        right = q["choices"][q["answer"] - 1]
+        assert f"** {right} — " in rest, right
 
 
 @pytest.mark.parametrize("page", LAB_PAGES)
@@ -630,8 +666,8 @@ def test_lab_script_opens_jupyterlab_offline_on_the_lab_notebooks(tmp_path):
     had_work = work.exists()
     if not had_work:  # un carnet « commencé » par l'étudiant : lab.sh ne doit pas l'écraser
         work.mkdir()
-        (work / f"{LAB_PAGES[0]}.ipynb").write_text((BOOK / "travaux-pratiques" / f"{LAB_PAGES[0]}.ipynb")
-                                                    .read_text().replace("# À vous", "# commencé"))
+        first = NOTEBOOKS[LAB_PAGES[0]]
+        (work / first).write_text((BOOK / "travaux-pratiques" / first).read_text().replace("# À vous", "# commencé"))
     existed = {p.name: p.read_bytes() for p in work.glob("*.ipynb")}
     port = _free_port()
     log = tmp_path / "lab.log"
@@ -652,13 +688,23 @@ def test_lab_script_opens_jupyterlab_offline_on_the_lab_notebooks(tmp_path):
             time.sleep(0.5)
         assert listing is not None, log.read_text()[-3000:]
         names = set(re.findall(r'"name": ?"([^"]+\.ipynb)"', listing))
-        assert names >= {f"{page}.ipynb" for page in LAB_PAGES}
+        assert names >= set(NOTEBOOKS.values())
         with urllib.request.urlopen(f"http://127.0.0.1:{port}/lab", timeout=10) as r:
             assert r.status == 200 and "JupyterLab" in r.read().decode()
+        # en français, sans la question des nouvelles (en anglais) ni la recherche de mises à jour
+        settings = f"http://127.0.0.1:{port}/lab/api/settings/"
+        with urllib.request.urlopen(settings + "@jupyterlab/apputils-extension:notification", timeout=10) as r:
+            notification = json.loads(r.read().decode())["schema"]["properties"]
+        assert notification["fetchNews"]["default"] == "false"
+        assert notification["checkForUpdates"]["default"] is False
+        with urllib.request.urlopen(settings + "@jupyterlab/translation-extension:plugin", timeout=10) as r:
+            assert json.loads(r.read().decode())["schema"]["properties"]["locale"]["default"] == "fr_FR"
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/lab/api/translations/fr_FR", timeout=10) as r:
+            assert "Fichier" in r.read().decode()  # le paquet de langue est installé
         for name, content in existed.items():  # un carnet commencé n'est jamais écrasé
             assert (work / name).read_bytes() == content
-        for page in LAB_PAGES:
-            assert (work / f"{page}.ipynb").is_file()
+        for name in NOTEBOOKS.values():
+            assert (work / name).is_file()
     finally:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGTERM)
@@ -670,7 +716,7 @@ def test_lab_script_opens_jupyterlab_offline_on_the_lab_notebooks(tmp_path):
 def test_binder_opens_the_lab_notebooks_with_the_pinned_jupyterlab():
     post = (ROOT / "binder" / "postBuild").read_text()
     folder = re.search(r'default_url = "/lab/tree/([^"]+)"', post).group(1)
-    assert sorted(p.stem for p in (ROOT / folder).glob("*.ipynb")) == LAB_PAGES
+    assert sorted(p.name for p in (ROOT / folder).glob("*.ipynb")) == [NOTEBOOKS[page] for page in LAB_PAGES]
     assert "-r ../requirements.txt" in (ROOT / "binder" / "requirements.txt").read_text()
     assert re.search(r"(?m)^jupyterlab==\d", (ROOT / "requirements.txt").read_text())
 
@@ -688,10 +734,13 @@ def test_built_lab_page_ran_its_solutions_and_offers_the_student_notebook(built_
     assert html.count('class="kc-verdict kc-verdict-reussi"') == checks
     assert "kc-verdict-a-corriger" not in html and "Fonction pas encore écrite" not in html
     assert "Votre filtre n&#39;a pas pu tourner" not in html and "Votre filtre n'a pas pu tourner" not in html
-    link = re.search(rf'href="(\.\./_downloads/[0-9a-f]+/{page}\.ipynb)"', html)
+    name = re.escape(NOTEBOOKS[page])
+    link = re.search(rf'href="(\.\./_downloads/[0-9a-f]+/{name})"', html)
     assert link, f"{page} : pas de lien de téléchargement du carnet"
     downloaded = (built_book / "book" / link.group(1)).resolve()
-    assert downloaded.read_bytes() == (BOOK / "travaux-pratiques" / f"{page}.ipynb").read_bytes()
+    assert downloaded.read_bytes() == (BOOK / "travaux-pratiques" / NOTEBOOKS[page]).read_bytes()
+    served = built_book / "travaux-pratiques" / NOTEBOOKS[page]
+    assert served.read_bytes() == downloaded.read_bytes()
     assert 'class="solution dropdown' in html
 
 
@@ -859,3 +908,85 @@ def test_a_lab_figure_blames_the_student_function_not_the_package():
     too_big = cell("def update(x_pred, P_pred, y, C, R):\n    return x_pred, np.zeros((2, 2))\n", "update")
     run = kc.scenarios.labs.voltage_lab(update=too_big)
     assert run.student is None and "labs.py" not in run.message and "ligne" not in run.message, run.message
+
+
+def test_hidden_cases_include_the_smallest_size_and_a_larger_one():
+    """Chaque régime : n = 1 (ou N = 1, m = 1, une seule ancre) et une taille ≥ 3 — une transposée oubliée
+    ou une identité de mauvaise taille passe en dimension 1."""
+    for ex in EXERCISES:
+        if ex.id in FIXED_SIZES:
+            continue
+        sizes = [min(min(a.shape) for a in c.args if isinstance(a, np.ndarray) and a.ndim >= 1) for c in ex.cases()]
+        largest = [max(max(a.shape) for a in c.args if isinstance(a, np.ndarray) and a.ndim >= 1) for c in ex.cases()]
+        assert min(sizes) == 1 and max(largest) >= 3, (ex.id, sizes, largest)
+
+
+def test_tracking_references_agree_with_independent_computations():
+    """TP 5 : l'intégrale de bruit par quadrature = la méthode de Van Loan du paquet = la forme close de la vitesse
+    presque constante ; le mélange et la combinaison de l'IMM = ceux d'`IMMEstimator` de filterpy ; la porte =
+    le quantile −2 ln(1 − p) quand m = 2."""
+    from filterpy.kalman import IMMEstimator, KalmanFilter
+
+    from kalman_course.practice import tracking
+
+    for case in tracking.VAN_LOAN.cases():
+        F, L, Qc, dt = case.args
+        A, Q = kc.discretize(F, L, Qc, dt)
+        assert np.allclose(case.expected[0], A, atol=1e-12) and np.allclose(case.expected[1], Q, rtol=1e-9, atol=1e-12)
+    for case in tracking.CV_MODEL.cases():
+        dt, q = case.args
+        A, Q = kc.constant_velocity(dt, q, dim=2)
+        assert np.allclose(case.expected[0], A) and np.allclose(case.expected[1], Q, rtol=1e-9, atol=1e-15)
+        one_axis = q * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]])
+        assert np.allclose(case.expected[1][np.ix_([0, 2], [0, 2])], one_axis, rtol=1e-9, atol=1e-15)
+    for case in tracking.NIS_GATE.cases():
+        if case.info["m"] == 2:
+            assert case.expected[1] == pytest.approx(-2 * np.log(1 - case.args[2]), rel=1e-10)
+    for case in tracking.IMM_MIX.cases() + tracking.IMM_MERGE.cases():
+        X, P, mu = case.args[:3]
+        r, n = X.shape
+        if r == 1:
+            continue
+        filters = []
+        for j in range(r):
+            f = KalmanFilter(dim_x=n, dim_z=1)
+            f.x, f.P, f.F, f.Q = X[j].copy(), P[j].copy(), np.eye(n), np.zeros((n, n))
+            filters.append(f)
+        transition = case.args[3] if len(case.args) == 4 else np.full((r, r), 1.0 / r)
+        imm = IMMEstimator(filters, mu.copy(), transition)
+        if len(case.args) == 4:  # mélange : la prédiction de filterpy avec des régimes immobiles
+            imm.predict()
+            assert np.allclose(imm.cbar, case.expected[0])
+            assert np.allclose([f.x for f in filters], case.expected[1])
+            assert np.allclose([f.P for f in filters], case.expected[2])
+        else:  # combinaison : l'estimation de filterpy avant toute prédiction
+            assert np.allclose(imm.x, case.expected[0]) and np.allclose(imm.P, case.expected[1])
+
+
+def test_the_lab_environment_holds_only_what_a_tp_needs():
+    """`scripts/lab.sh` (environnement .venv-tp/) installe `scripts/lab-requirements.txt` sous les contraintes de
+    requirements.txt : résolu hors ligne par uv, l'ensemble contient JupyterLab, son paquet de langue, le noyau
+    et les dépendances du paquet, aux versions figées, et rien de ce qui construit ou teste le livre."""
+    import tomllib
+
+    uv = Path(sys.executable).parent / "uv"
+    done = subprocess.run([str(uv), "pip", "compile", "--offline", "--quiet", "--python", sys.executable,
+                           "scripts/lab-requirements.txt", "-c", "requirements.txt", "--no-header", "--no-annotate"],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    resolved = dict(re.findall(r"(?m)^([\w.-]+)==(\S+)$", done.stdout))
+    names = {n.lower().replace("_", "-") for n in resolved}
+    pins = {n.lower().replace("_", "-"): v for n, v in re.findall(r"(?m)^([\w.-]+)==(\S+)$",
+                                                                 (ROOT / "requirements.txt").read_text())}
+    assert {"jupyterlab", "jupyterlab-language-pack-fr-fr", "ipykernel", "numpy", "scipy", "matplotlib"} <= names
+    for heavy in ("playwright", "jupyter-book", "sphinx", "myst-nb", "filterpy", "statsmodels", "bokeh", "pytest"):
+        assert heavy not in names, heavy
+    assert all(pins[n.lower().replace("_", "-")] == v for n, v in resolved.items())
+    assert len(names) < 0.8 * len(pins)
+    package = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["dependencies"]
+    lab = {ln.strip() for ln in (ROOT / "scripts" / "lab-requirements.txt").read_text().splitlines()
+           if ln.strip() and not ln.startswith("#")}
+    assert set(package) <= lab
+    script = (ROOT / "scripts" / "install_requirements.sh").read_text()
+    lab_part = script.split('"--lab" ]', 1)[1].split("exit 0", 1)[0]
+    assert "--quiet" not in lab_part  # la progression d'uv s'affiche

@@ -40,6 +40,7 @@ CHAPTER_TITLES: dict[str, str] = {
     "tp-ekf-tag": "TP 2 — Le filtre de Kalman étendu : suivre le tag radio",
     "tp-ukf-particulaire": "TP 3 — UKF et filtre particulaire : le pendule",
     "tp-lissage-em": "TP 4 — Lisser et apprendre : le Nil",
+    "tp-helicoptere-samu": "TP 5 — Pister l'hélicoptère du SAMU 31",
     "td-filtre-lineaire": "TD 1 — Le gain de Kalman à la main",
     "td-filtres-a-points": "TD 2 — Filtres à points : calculs à la main",
     "td-lissage-em": "TD 3 — Lissage et EM à la main",

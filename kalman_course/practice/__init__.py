@@ -31,16 +31,18 @@ from .linear import JOSEPH_UPDATE, KF_PREDICT, KF_UPDATE, NIS
 from .nonlinear import EKF_UPDATE, SO3_EXP, TAG_JACOBIAN
 from .sampling import PARTICLE_WEIGHTS, SIGMA_POINTS, SYSTEMATIC_RESAMPLE, UNSCENTED_TRANSFORM
 from .smoothing import EM_M_STEP, RTS_STEP
+from .tracking import CV_MODEL, IMM_MERGE, IMM_MIX, MODE_PROBABILITIES, NIS_GATE, VAN_LOAN
 from .verdict import Verdict
 
 __all__ = ["Attempt", "Case", "Exercise", "Mistake", "Output", "Verdict", "attempt", "check", "exercise", "exercises",
-           "exercise_table", "validated"]
+           "exercise_table", "validated", "wheel_name"]
 
 _EXERCISES: tuple[Exercise, ...] = (
     KF_PREDICT, KF_UPDATE, JOSEPH_UPDATE, NIS,
     EKF_UPDATE, TAG_JACOBIAN, SO3_EXP,
     SIGMA_POINTS, UNSCENTED_TRANSFORM, SYSTEMATIC_RESAMPLE, PARTICLE_WEIGHTS,
     RTS_STEP, EM_M_STEP,
+    CV_MODEL, VAN_LOAN, NIS_GATE, IMM_MIX, MODE_PROBABILITIES, IMM_MERGE,
 )
 _BY_ID = {ex.id: ex for ex in _EXERCISES}
 
@@ -93,6 +95,18 @@ class Attempt(NamedTuple):
 
     value: Any
     message: str | None
+
+
+def wheel_name() -> str:
+    """Le nom de la roue du paquet servie par le site (``kalman_course-<version>-py3-none-any.whl``) : la
+    version est celle du paquet installé (``pyproject.toml``)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        number = version("kalman_course")
+    except PackageNotFoundError:  # pragma: no cover — paquet lu depuis le dépôt sans installation
+        number = "0.1.0"
+    return f"kalman_course-{number}-py3-none-any.whl"
 
 
 def validated(exercise_id: str, fn: Callable[..., Any]) -> Callable[..., Any]:
