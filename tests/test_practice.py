@@ -990,3 +990,208 @@ def test_the_lab_environment_holds_only_what_a_tp_needs():
     script = (ROOT / "scripts" / "install_requirements.sh").read_text()
     lab_part = script.split('"--lab" ]', 1)[1].split("exit 0", 1)[0]
     assert "--quiet" not in lab_part  # la progression d'uv s'affiche
+
+
+# --------------------------------------------------------------------------- TD 4, TD 5, examen, TP 5 : réponses recalculées
+
+
+def test_tutorial_four_answers_are_recomputed():
+    """TD 4 : Q par l'intégrale (forme close), le seuil −2 ln(1 − p) (contre scipy), le pas d'IMM (calcul direct
+    écrit ici, contre kc.imm_filter)."""
+    text = _page("td-cibles-reelles")
+    assert "Durée indicative" in text
+    # 1. Q pour Δt = 2 s, q = 3 m²/s³
+    dt, q = 2.0, 3.0
+    Q = q * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]])
+    assert np.allclose(Q, [[8, 6], [6, 6]]) and np.linalg.det(Q) == pytest.approx(12.0)
+    assert np.linalg.det(Q - np.diag([8.0, 0.0])) == pytest.approx(-36.0)
+    assert r"\begin{bmatrix} 8 & 6 \\ 6 & 6 \end{bmatrix}" in text and r"\det Q = 48 - 36 = 12 > 0" in text
+    assert r"\det = 0 \times 6 - 36 = -36 < 0" in text
+    assert np.allclose(kc.scenarios.tutorials.cv_noise_example().Q, Q, rtol=1e-10)
+    # 2. la porte pour m = 2
+    for p, shown in ((0.99, "9{,}21"), (0.999, "13{,}82")):
+        threshold = -2 * np.log(1 - p)
+        assert threshold == pytest.approx(scipy.stats.chi2.ppf(p, 2), rel=1e-12)
+        assert f"{threshold:.2f}".replace(".", "{,}") == shown and shown in text
+    assert (3**2 + 4**2) / 4 == 6.25 and (6**2 + 8**2) / 4 == 25.0 and "6{,}25" in text
+    gate = kc.scenarios.tutorials.gate_example()
+    assert np.allclose(gate["nis"], [6.25, 25.0]) and np.allclose(gate["thresholds"], [-2 * np.log(0.01), -2 * np.log(0.001)])
+    assert "13,28" in text and scipy.stats.chi2.ppf(0.99, 4) == pytest.approx(13.28, abs=0.005)
+    # 3. le pas d'IMM, à la main
+    mu, Pi = np.array([0.5, 0.5]), np.array([[0.9, 0.1], [0.3, 0.7]])
+    cbar = mu @ Pi
+    W = Pi * mu[:, None] / cbar
+    X, P = np.array([0.0, 4.0]), np.array([1.0, 1.0])
+    x0 = W.T @ X
+    P0 = np.array([sum(W[i, j] * (P[i] + (X[i] - x0[j]) ** 2) for i in range(2)) for j in range(2)])
+    assert np.allclose(cbar, [0.6, 0.4]) and np.allclose(W, [[0.75, 0.125], [0.25, 0.875]])
+    assert np.allclose(x0, [1.0, 3.5]) and np.allclose(P0, [4.0, 2.75])
+    Pm = P0 + np.array([0.0, 1.25])
+    S = Pm + 1.0
+    nu = 3.0 - x0
+    K = Pm / S
+    xm, Pp = x0 + K * nu, (1 - K) * Pm
+    assert np.allclose(S, [5, 5]) and np.allclose(xm, [2.6, 3.1]) and np.allclose(Pp, [0.8, 0.8])
+    ratio = cbar[1] / cbar[0] * np.exp((nu[0] ** 2 - nu[1] ** 2) / (2 * 5.0))
+    assert ratio == pytest.approx(0.970, abs=5e-4) and "0{,}970" in text
+    mu_new = np.array([1.0, ratio]) / (1 + ratio)
+    x = mu_new @ xm
+    Pc = mu_new @ Pp + mu_new @ (xm - x) ** 2
+    assert f"{mu_new[0]:.3f}" == "0.508" and f"{mu_new[1]:.3f}" == "0.492"
+    assert f"{x:.3f}" == "2.846" and f"{Pc:.3f}" == "0.862"
+    for shown in ("\\mu_0 = 1/1{,}970 = 0{,}508", "\\mu_1 = 0{,}492", "= 2{,}846", "= 0{,}862"):
+        assert shown in text, shown
+    step = kc.scenarios.tutorials.imm_step()
+    assert np.allclose(step.mu_pred[0], cbar) and np.allclose(step.x_modes[0, :, 0], xm)
+    assert np.allclose(step.P_modes[0, :, 0, 0], Pp) and np.allclose(step.mu[0], mu_new, rtol=1e-12)
+    assert step.x[0, 0] == pytest.approx(x, rel=1e-12) and step.P[0, 0, 0] == pytest.approx(Pc, rel=1e-12)
+
+
+def test_tutorial_five_answers_are_recomputed():
+    """TD 5 : éléments et combinaisons du filtre parallèle en fractions exactes (formules du chapitre, écrites
+    ici), contre le filtre de Kalman du TD 3 et le paquet ; le pas du filtre d'information en fractions."""
+    text = _page("td-autres-formes")
+    assert "Durée indicative" in text
+    F = Fraction
+
+    def element(y, first=False):
+        S, K = F(2), F(1, 2)
+        if first:  # a priori (0, 1), prédiction (0, 2), gain 2/3
+            return (F(0), F(2, 3) * y, F(2, 3), F(0), F(0))
+        return (1 - K, K * y, (1 - K) * 1, y / S, 1 / S)
+
+    def combine(a, b):
+        Fi, bi, Si, ei, Ji = a
+        Fj, bj, Sj, ej, Jj = b
+        M = 1 / (1 + Si * Jj)
+        return (Fj * M * Fi, Fj * M * (bi + Si * ej) + bj, Fj**2 * M * Si + Sj, Fi * M * (ej - Jj * bi) + ei,
+                Fi**2 * M * Jj + Ji)
+
+    a1, a2, a3 = element(F(1), True), element(F(3)), element(F(2))
+    a12, a23 = combine(a1, a2), combine(a2, a3)
+    a1_23 = combine(a1, a23)
+    assert a2 == (F(1, 2), F(3, 2), F(1, 2), F(3, 2), F(1, 2)) and a3 == (F(1, 2), F(1), F(1, 2), F(1), F(1, 2))
+    assert a12[:3] == (0, F(17, 8), F(5, 8)) and a23 == (F(1, 5), F(9, 5), F(3, 5), F(8, 5), F(3, 5))
+    assert a1_23[:3] == (0, F(43, 21), F(13, 21)) and combine(a12, a3)[:3] == a1_23[:3]
+    steps = kc.scenarios.tutorials.three_step_smoothing()  # le TD 3 : le filtre de Kalman sur les mêmes mesures
+    assert float(a12[1]) == pytest.approx(steps.x[1]) and float(a1_23[2]) == pytest.approx(steps.P[2])
+    package = kc.scenarios.tutorials.parallel_elements()
+    for name, value in (("a1", a1), ("a2", a2), ("a3", a3), ("a12", a12), ("a23", a23), ("a1_23", a1_23)):
+        assert np.allclose(package[name], [float(v) for v in value], atol=1e-14), name
+    for shown in ("(0,\\ 2/3,\\ 2/3,\\ 0,\\ 0)", "(1/2,\\ 3/2,\\ 1/2,\\ 3/2,\\ 1/2)", "= 17/8", "= 5/8", "= 9/5",
+                  "= 3/5", "= 8/5", "= 43/21", "= 13/21", "M = 1/(1 + \\tfrac23 \\cdot \\tfrac35) = 5/7"):
+        assert shown in text, shown
+    # 2. le filtre d'information : fractions exactes
+    Pm = np.array([[F(2), F(1)], [F(1), F(2)]], dtype=object)
+    det = Pm[0, 0] * Pm[1, 1] - Pm[0, 1] ** 2
+    Ym = np.array([[Pm[1, 1], -Pm[0, 1]], [-Pm[1, 0], Pm[0, 0]]], dtype=object) / det
+    zeta_m = Ym @ np.array([F(1), F(0)], dtype=object)
+    Y = Ym + np.array([[F(1), F(0)], [F(0), F(0)]], dtype=object)
+    zeta = zeta_m + np.array([F(3), F(0)], dtype=object)
+    detY = Y[0, 0] * Y[1, 1] - Y[0, 1] * Y[1, 0]
+    P = np.array([[Y[1, 1], -Y[0, 1]], [-Y[1, 0], Y[0, 0]]], dtype=object) / detY
+    x = P @ zeta
+    assert detY == 1 and list(zeta_m) == [F(2, 3), F(-1, 3)] and list(zeta) == [F(11, 3), F(-1, 3)]
+    assert list(x) == [F(7, 3), F(2, 3)] and P.tolist() == [[F(2, 3), F(1, 3)], [F(1, 3), F(5, 3)]]
+    for shown in ("\\zeta^- = (2/3,\\ -1/3)", "(11/3,\\ -1/3)", "\\hat x = P\\zeta = (7/3,\\ 2/3)",
+                  "\\begin{bmatrix} 2/3 & 1/3 \\\\ 1/3 & 5/3 \\end{bmatrix}", "K = P^-C^T/S = (2/3,\\ 1/3)"):
+        assert shown in text, shown
+    info = kc.scenarios.tutorials.information_step()
+    assert np.allclose(info["x"], [7 / 3, 2 / 3]) and np.allclose(info["P"], P.astype(float))
+    assert np.allclose(info["Y"], Y.astype(float)) and np.allclose(info["kalman_x"], info["x"])
+
+
+def test_exam_has_a_two_hour_paper_a_marking_scheme_summing_to_twenty_and_checked_answers():
+    text = _page("sujet-examen")
+    assert "**Durée : 2 heures.**" in text
+    rows = [r for r in text.split("**Barème**", 1)[1].split("\n\n", 2)[1].splitlines() if r.startswith("| ") and
+            not r.startswith("| exercice")]
+    points = [[float(c.strip().replace(",", ".")) if c.strip() not in ("—", "") else 0.0 for c in r.strip("|").split("|")[1:]]
+              for r in rows]
+    assert len(points) == 4 and all(sum(p[:-1]) == p[-1] for p in points) and sum(p[-1] for p in points) == 20
+    for k, total in enumerate(p[-1] for p in points):
+        assert re.search(rf"## Exercice {k + 1} — .*\({total:g} points\)", text), (k, total)
+    # chaque question de l'énoncé porte les points du barème
+    for k, p in enumerate(points, 1):
+        statement = text.split(f"## Exercice {k} —", 1)[1].split("```{solution-start}", 1)[0]
+        marks = [float(v.replace(",", ".")) for v in re.findall(r"\((\d+(?:,\d+)?) pts?\)", statement)]
+        assert marks == [v for v in p[:-1] if v], (k, marks)
+    # 1. gain stationnaire : le nombre d'or
+    phi = (1 + np.sqrt(5)) / 2
+    run = kc.scenarios.tutorials.exam_stationary()
+    assert run["P_pred"][-1] == pytest.approx(phi, rel=1e-9) and run["K"][-1] == pytest.approx(1 / phi, rel=1e-9)
+    assert run["P"][-1] == pytest.approx(1 / phi, rel=1e-9) and run["S"][-1] == pytest.approx(phi**2, rel=1e-9)
+    assert phi**2 == pytest.approx(phi + 1) and (1 / phi) * (1 - 1 / phi) ** 3 == pytest.approx(phi**-7)
+    for shown in ("\\approx 1{,}618", "\\approx 0{,}618", "\\approx 2{,}618", "\\approx 0{,}034", "= 0{,}742",
+                  "= 1{,}296"):
+        assert shown in text, shown
+    assert f"{phi**-7:.3f}" == "0.034"
+    assert np.allclose(scipy.stats.chi2.ppf([0.025, 0.975], 100), [74.22, 129.56], atol=0.005)
+    # 2. EKF sur une distance
+    H = np.array([0.6, 0.8])
+    S = H @ H + 0.25
+    K = H / S
+    x = np.array([3.0, 4.0]) + K * 0.5
+    P = np.eye(2) - np.outer(K, H)
+    assert S == pytest.approx(1.25) and np.allclose(K, [0.48, 0.64]) and np.allclose(x, [3.24, 4.32])
+    assert np.allclose(P, [[0.712, -0.384], [-0.384, 0.488]]) and H @ P @ H == pytest.approx(0.2)
+    assert np.array([-0.8, 0.6]) @ P @ np.array([-0.8, 0.6]) == pytest.approx(1.0)
+    ekf = kc.scenarios.tutorials.exam_range_update()
+    assert np.allclose(ekf.x, x) and np.allclose(ekf.P, P) and np.allclose(ekf.K[:, 0], K)
+    for shown in ("(0{,}48 ;\\ 0{,}64)", "(3{,}24 ;\\ 4{,}32)", "0{,}712 & -0{,}384", "= 5{,}1$ m"):
+        assert shown in text, shown
+    mc = np.random.default_rng(0).multivariate_normal([3.0, 4.0], np.eye(2), size=400_000)
+    assert np.hypot(mc[:, 0], mc[:, 1]).mean() == pytest.approx(5.1, abs=0.005)  # l'ordre 2 : 5,1 m
+    # 3. lissage et R'
+    F = Fraction
+    two = kc.scenarios.tutorials.exam_smoothing()
+    for value, exact in ((two.x[0], F(4, 3)), (two.P[0], F(2, 3)), (two.x[1], F(1, 2)), (two.P[1], F(5, 8)),
+                         (two.G[0], F(2, 5)), (two.xs[0], F(1)), (two.Ps[0], F(1, 2)), (two.R_new, F(19, 16))):
+        assert value == pytest.approx(float(exact), abs=1e-14)
+    assert F(1, 2) * ((2 - 1) ** 2 + F(1, 2) + F(1, 2) ** 2 + F(5, 8)) == F(19, 16) and "= 19/16$" in text
+    # 4. pistage
+    track = kc.scenarios.tutorials.exam_tracking()
+    assert np.allclose(track["Q"], 6 * np.array([[1 / 3, 1 / 2], [1 / 2, 1]])) and np.allclose(track["Q"], [[2, 3], [3, 6]])
+    assert np.allclose(track["nis"], [2.0, 13.0]) and -2 * np.log(0.01) < 13 < -2 * np.log(0.001)
+    assert np.allclose(track["cbar"], [0.61, 0.39])
+    assert np.allclose(track["weights"], [[0.57 / 0.61, 0.03 / 0.39], [0.04 / 0.61, 0.36 / 0.39]])
+    for shown in ("0{,}57/0{,}61 = 0{,}934", "0{,}04/0{,}61 =\n   0{,}066", "0{,}03/0{,}39 = 0{,}077",
+                  "0{,}36/0{,}39 = 0{,}923", "\\epsilon = 36/4 + 4/1 = 13"):
+        assert shown in text, shown
+
+
+def test_capstone_lab_quiz_numbers_and_lab_constants_are_recomputed():
+    """TP 5 : les nombres du quiz (quantiles du χ², c̄, Δt³/3) et les réglages de l'expérience (appris au chapitre)."""
+    text = _page("tp-helicoptere-samu")
+    assert "Durée indicative : 3 h 30" in text
+    assert f"{scipy.stats.chi2.ppf(0.999, 1):.1f}" == "10.8" and f"{scipy.stats.chi2.ppf(0.999, 2):.1f}" == "13.8"
+    assert "seuil 10,8 au lieu de 13,8" in text
+    assert np.array([0.5, 0.5]) @ np.array([[0.95, 0.05], [0.2, 0.8]]) == pytest.approx([0.575, 0.425])
+    assert "\\bar c_1 = 0{,}05 \\times 0{,}5 + 0{,}80 \\times 0{,}5 = 0{,}425" in text
+    assert round(8.0**3 / 3) == 171 and "\\Delta t^3/3 \\approx 171" in text
+    labs = kc.scenarios.labs
+    q, sp = kc.scenarios.helicopter.fitted_parameters("position")
+    assert labs.LAB_SAMU_Q == pytest.approx(q, rel=0.02) and labs.LAB_SAMU_POSITION_STD == pytest.approx(sp, rel=0.03)
+    assert "q = 12{,}5" in text and "1,9 m" in text and "q = 3" in text and "q = 100" in text and "0,02" in text
+    assert labs.LAB_SAMU_MODES == (3.0, 100.0) and labs.LAB_SAMU_SWITCH == 0.02 and labs.LAB_SAMU_GATE == 0.999
+
+
+def test_capstone_lab_with_its_solutions_equals_the_package_and_each_classic_mistake_breaks_it():
+    s = _lab_functions("tp-helicoptere-samu", "solution")
+    run = kc.scenarios.labs.samu_lab(**{name: s[ex] for name, ex in (
+        ("cv_model", "cv-model"), ("nis_gate", "nis-gate"), ("van_loan", "van-loan"), ("imm_mix", "imm-mix"),
+        ("mode_probabilities", "mode-probabilities"), ("imm_merge", "imm-merge"))})
+    assert run.message is None
+    assert np.allclose(run.student["gate_x"], run.reference["gate_x"], atol=1e-8)
+    assert np.array_equal(run.student["rejected"], run.reference["rejected"])
+    assert set(run.data["outliers"]) <= set(np.flatnonzero(run.reference["rejected"]))
+    assert np.allclose(run.student["imm_x"], run.reference["imm_x"], atol=1e-8)
+    assert np.allclose(run.student["mu"], run.reference["mu"], atol=1e-10)
+    # l'IMM suit les virages : μ(agité) est plus forte quand la vitesse de virage mesurée est grande
+    turning = np.interp(run.data["t"], run.data["rate_t"], np.abs(run.data["rate"])) > 3.0
+    assert run.reference["mu"][turning, 1].mean() > 0.5 > run.reference["mu"][~turning, 1].mean()
+    # une erreur classique se voit sur le vol : la vraisemblance des régimes sans det S_j favorise l'agité
+    # (la transition du TP est symétrique : l'y transposer ne changerait rien, d'où les cas cachés non symétriques)
+    no_det = next(m.example for m in practice.exercise("mode-probabilities").mistakes if m.id == "no-determinant")
+    wrong = kc.scenarios.labs.samu_lab(mode_probabilities=no_det)
+    assert wrong.student["mu"][:, 1].mean() > run.reference["mu"][:, 1].mean() + 0.05

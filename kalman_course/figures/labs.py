@@ -164,7 +164,7 @@ def samu_lab_figure(cv_model=None, nis_gate=None, van_loan=None, imm_mix=None, m
     ax.legend(loc="lower left", fontsize=7)
     turn = az.twinx()
     turn.fill_between(run.data["rate_t"], np.abs(run.data["rate"]), color="0.85", lw=0, zorder=0)
-    turn.set_ylabel("vitesse de virage mesurée (°/s), en gris", color="0.35")
+    turn.set_ylabel("vitesse de virage mesurée, en gris (°/s)", color="0.35")
     turn.set_ylim(0.0, 1.03 * float(np.max(np.abs(run.data["rate"]))))
     az.set_zorder(turn.get_zorder() + 1)
     az.patch.set_visible(False)

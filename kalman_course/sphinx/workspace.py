@@ -78,8 +78,8 @@ def commands(notebook: str, wheel: str) -> str:
     folder = f"{PLACEHOLDER}/travaux-pratiques"
     return (f"python3 -m venv {VENV}\n"
             f"source {VENV}/bin/activate\n"
-            f'python -m pip install -c "{folder}/{CONSTRAINTS}" "{folder}/{wheel}" jupyterlab '
-            f"jupyterlab-language-pack-fr-fr\n"
+            f'python -m pip install -c "{folder}/{CONSTRAINTS}" "{folder}/{wheel}"\n'
+            f'python -m pip install -c "{folder}/{CONSTRAINTS}" jupyterlab jupyterlab-language-pack-fr-fr\n'
             f"jupyter lab {notebook}")
 
 
@@ -146,8 +146,8 @@ class WorkspaceDirective(SphinxDirective):
             "repliées : essayez d'abord !")
         box += _paragraph(
             nodes.strong("", "Sur votre ordinateur"), " (Python 3.11, 3.12 ou 3.13), dans le dossier où vous avez "
-            "enregistré le carnet : un environnement virtuel, le paquet du cours et JupyterLab en français, "
-            "installés depuis ce site, aux versions avec lesquelles le cours est vérifié.")
+            "enregistré le carnet : un environnement virtuel, le paquet du cours (depuis ce site), puis JupyterLab "
+            "en français, aux versions avec lesquelles le cours est vérifié.")
         block = nodes.literal_block(commands(notebook, wheel), commands(notebook, wheel), language="text")
         box += block
         note = nodes.inline("", "", classes=["kc-adresse"])
