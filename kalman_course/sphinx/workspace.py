@@ -18,8 +18,8 @@ r"""Extension Sphinx du livre : les travaux pratiques sur l'ordinateur de l'étu
 (environnement virtuel, ``pip install`` de la roue **depuis ce site**, ``jupyter lab``) ; et, quand
 ``_config.yml`` nomme un dépôt (``repository: url:``), ``bash scripts/lab.sh`` depuis une copie du dépôt et le
 lien Binder (et JupyterHub si ``launch_buttons: jupyterhub_url:`` est donné). Les commandes portent
-l'adresse ``ADRESSE-DU-COURS`` : dans la page, un petit script la remplace par l'adresse du dossier
-``travaux-pratiques/`` calculée depuis l'adresse de la page elle-même (``document.baseURI``) — le site
+l'adresse ``ADRESSE-DU-COURS`` : dans la page, un petit script la remplace par l'adresse de la racine du
+site, calculée depuis l'adresse de la page elle-même (``document.baseURI``) — le site
 publié n'importe où, ou une copie locale ouverte depuis le disque (``file://`` : un chemin de fichier,
 que pip accepte). Dans le PDF, les commandes gardent ``ADRESSE-DU-COURS`` et une phrase dit par quoi la
 remplacer.
@@ -55,10 +55,10 @@ VENV = "tp-kalman"
 
 _SCRIPT = """<script>(function () {
   var box = document.currentScript.parentNode;
-  var folder = new URL(%s, document.baseURI);
-  var base = folder.href.replace(/\\/$/, "");
-  if (folder.protocol === "file:") {
-    base = decodeURIComponent(folder.pathname).replace(/\\/$/, "");
+  var root = new URL(%s, document.baseURI);
+  var base = root.href.replace(/\\/$/, "");
+  if (root.protocol === "file:") {
+    base = decodeURIComponent(root.pathname).replace(/\\/$/, "");
     if (/^\\/[A-Za-z]:\\//.test(base)) { base = base.slice(1); }
   }
   box.querySelectorAll("pre").forEach(function (pre) {
@@ -171,8 +171,8 @@ class WorkspaceDirective(SphinxDirective):
                     para += _link(name, url)
                 para += nodes.Text(" (les carnets sont dans le dossier book/travaux-pratiques).")
             box += para
-        folder = posixpath.relpath(WHEEL_FOLDER, posixpath.dirname(self.env.docname) or ".") + "/"
-        script = _SCRIPT % (_js(folder), _js(PLACEHOLDER), _js(PLACEHOLDER))
+        root = posixpath.relpath(".", posixpath.dirname(self.env.docname) or ".") + "/"  # la racine du site
+        script = _SCRIPT % (_js(root), _js(PLACEHOLDER), _js(PLACEHOLDER))
         box += nodes.raw("", script, format="html")
         return [box]
 
