@@ -100,21 +100,27 @@ def _venv_python(venv: Path) -> Path:
     return venv / ("Scripts/python.exe" if sys.platform == "win32" else "bin/python")
 
 
+#: Dans l'environnement neuf, un seul processus (une seule importation) : pour chaque réponse, les cellules du
+#: carnet dans l'ordre, la fonction à écrire remplacée par la réponse, jusqu'à la première vérification.
 _CHECK = r"""
 import json, sys
-notebook, answer = json.load(open(sys.argv[1])), sys.argv[2]
-namespace = {}
-for cell in notebook["cells"]:
-    if cell["cell_type"] != "code":
-        continue
-    source = "".join(cell["source"])
-    if "raise NotImplementedError" in source:
-        source = answer
-    if source.startswith("practice.check("):
-        verdict = eval(source, namespace)
-        print(json.dumps({"passed": verdict.passed, "feedback": verdict.feedback, "mistake": verdict.mistake}))
-        break
-    exec(source, namespace)
+notebook, answers = json.load(open(sys.argv[1])), json.loads(sys.argv[2])
+verdicts = []
+for answer in answers:
+    namespace = {}
+    for cell in notebook["cells"]:
+        if cell["cell_type"] != "code":
+            continue
+        source = "".join(cell["source"])
+        if "raise NotImplementedError" in source:
+            source = answer
+        if source.startswith("practice.check("):
+            verdict = eval(source, namespace)
+            verdicts.append({"passed": verdict.passed, "feedback": verdict.feedback, "mistake": verdict.mistake})
+            break
+        exec(source, namespace)
+import kalman_course
+print(json.dumps({"verdicts": verdicts, "package": kalman_course.__file__}))
 """
 
 _RIGHT = "def predict(x, P, A, Q):\n    return A @ x, A @ P @ A.T + Q\n"
@@ -144,7 +150,7 @@ def test_a_student_installs_the_package_from_the_served_site_and_runs_a_lab_chec
         folder = f"{site.base}{FOLDER}"
         assert PLACEHOLDER not in printed and f'"{folder}/{kc.practice.wheel_name()}"' in printed
         assert f'"{built_book / FOLDER / kc.practice.wheel_name()}"' in printed_local
-        assert note == f"Les adresses ont été remplies d'après celle de cette page : {site.base}."
+        assert note == f"Les adresses ont été remplies d\u2019après celle de cette page\u00a0: {site.base}."
         wheel_command = next(shlex.split(line) for line in printed.splitlines() if ".whl" in line)
         assert wheel_command[:4] == ["python", "-m", "pip", "install"]
         arguments = wheel_command[4:]  # -c <contraintes du site> <roue du site>, comme sur la page
@@ -179,18 +185,14 @@ def test_a_student_installs_the_package_from_the_served_site_and_runs_a_lab_chec
         # le carnet du site : sa première vérification, juste puis fausse
         nb = tmp_path / notebook
         nb.write_bytes(urllib.request.urlopen(f"{folder}/{notebook}", timeout=30).read())
-    verdicts = {}
     env = {"PATH": str(python.parent), "MPLBACKEND": "Agg", "OPENBLAS_NUM_THREADS": "1", "HOME": str(tmp_path)}
-    for name, answer in (("juste", _RIGHT), ("fausse", _WRONG)):
-        run = subprocess.run([str(python), "-c", _CHECK, str(nb), answer], capture_output=True, text=True,
-                             timeout=120, cwd=tmp_path, env=env)
-        assert run.returncode == 0, run.stderr
-        verdicts[name] = json.loads(run.stdout.strip().splitlines()[-1])
-    assert verdicts["juste"]["passed"], verdicts["juste"]["feedback"]
-    wrong = verdicts["fausse"]
+    run = subprocess.run([str(python), "-c", _CHECK, str(nb), json.dumps([_RIGHT, _WRONG])], capture_output=True,
+                         text=True, timeout=300, cwd=tmp_path, env=env)
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout.strip().splitlines()[-1])
+    right, wrong = out["verdicts"]
+    assert right["passed"], right["feedback"]
     assert not wrong["passed"] and wrong["mistake"] == "apa"
     assert "Erreur classique : A P A au lieu de A P Aᵀ" in wrong["feedback"] and "transposée" in wrong["feedback"]
-    # le paquet installé est bien celui de l'environnement neuf, pas celui du dépôt
-    where = subprocess.run([str(python), "-c", "import kalman_course; print(kalman_course.__file__)"],
-                           capture_output=True, text=True, timeout=60, cwd=tmp_path, env=env)
-    assert str(venv) in where.stdout and str(ROOT) not in where.stdout
+    # le paquet qui a répondu est celui de l'environnement neuf, pas celui du dépôt
+    assert out["package"].startswith(str(venv)) and not out["package"].startswith(str(ROOT))

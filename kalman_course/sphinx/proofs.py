@@ -16,7 +16,8 @@ premier paragraphe, sans le traduire. Le livre écrit ses démonstrations ainsi 
 
 et l'extension, à la lecture de chaque page, retire « Proof. » et donne à l'encadré le titre
 « Démonstration » : sur le site, l'encadré est replié derrière ce titre (sphinx-togglebutton, classe
-``dropdown``) ; dans le PDF, il est imprimé en entier sous ce titre. Le symbole ∎ clôt la démonstration.
+``dropdown``) ; dans le PDF, il est imprimé en entier sous ce titre. Le symbole ∎ (□ dans le PDF, dont les
+polices n'ont pas ∎) clôt la démonstration.
 """
 
 from __future__ import annotations
@@ -42,8 +43,9 @@ def _retitle(app, doctree) -> None:
                 first.parent.replace(first, nodes.Text(first.astext()[len(_PREFIX):]))
             box.insert(0, nodes.title(TITLE, TITLE))
             last = [p for p in box.findall(nodes.paragraph)]
-            if last:
-                last[-1] += nodes.Text(" ∎")
+            if last:  # le symbole de fin : ∎ sur le site ; carré d'amssymb dans le PDF (∎ manque aux polices)
+                last[-1] += nodes.raw("", " ∎", format="html")
+                last[-1] += nodes.raw("", r"\hfill\(\square\)", format="latex")
             break
 
 

@@ -68,7 +68,7 @@ _SCRIPT = """<script>(function () {
     }
   });
   box.querySelectorAll(".kc-adresse").forEach(function (span) {
-    span.textContent = "Les adresses ont été remplies d'après celle de cette page : " + base + "/.";
+    span.textContent = "Les adresses ont été remplies d\u2019après celle de cette page\u00a0: " + base + "/.";
   });
 })();</script>"""
 
@@ -145,9 +145,10 @@ class WorkspaceDirective(SphinxDirective):
             "votre fonction sur des cas cachés et répond en français. Sur cette page, les solutions sont "
             "repliées : essayez d'abord !")
         box += _paragraph(
-            nodes.strong("", "Sur votre ordinateur"), " (Python 3.11, 3.12 ou 3.13), dans le dossier où vous avez "
-            "enregistré le carnet : un environnement virtuel, le paquet du cours (depuis ce site), puis JupyterLab "
-            "en français, aux versions avec lesquelles le cours est vérifié.")
+            nodes.strong("", "Sur votre ordinateur"), " (Python ", _code("3.11"), ", ", _code("3.12"), " ou ",
+            _code("3.13"), "), dans le dossier où vous avez enregistré le carnet : un environnement virtuel, le "
+            "paquet du cours (depuis ce site), puis JupyterLab en français, aux versions avec lesquelles le cours "
+            "est vérifié.")
         block = nodes.literal_block(commands(notebook, wheel), commands(notebook, wheel), language="text")
         box += block
         note = nodes.inline("", "", classes=["kc-adresse"])
