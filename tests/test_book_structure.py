@@ -32,7 +32,7 @@ CHAPTERS = [p for p in TOC if p not in APPENDICES and p != TOC[0]]
 #: les encadrés « Objectifs » et « Prérequis » (les chapitres à avoir lus) et finissent par un quiz ; elles
 #: n'ont ni section « À retenir » (un encadré la remplace, après le quiz), ni « La suite », ni bibliographie :
 #: le cours qu'elles exercent est dans les chapitres cités en prérequis.
-PRACTICE = [p for p in CHAPTERS if re.match(r"t[dp]-", p)]
+PRACTICE = [p for p in CHAPTERS if re.match(r"t[dp]-|sujet-examen$", p)]
 LESSONS = [p for p in CHAPTERS if p not in PRACTICE]
 
 
@@ -172,8 +172,8 @@ def test_practice_furniture_check_flags_missing_boxes_and_quiz():
 
 
 def test_practice_pages_are_the_td_and_tp_pages():
-    assert PRACTICE and all(p.startswith(("td-", "tp-")) for p in PRACTICE)
-    assert len(LESSONS) >= 20 and not any(p.startswith(("td-", "tp-")) for p in LESSONS)
+    assert PRACTICE and all(p.startswith(("td-", "tp-", "sujet-examen")) for p in PRACTICE)
+    assert len(LESSONS) >= 20 and not any(p.startswith(("td-", "tp-", "sujet-")) for p in LESSONS)
 
 
 @pytest.mark.parametrize("page", PRACTICE)

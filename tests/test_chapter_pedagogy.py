@@ -23,7 +23,8 @@ APPENDICES = {"references", "errata", "glossaire"}
 #: Travaux dirigés (papier et crayon) et travaux pratiques (l'étudiant écrit le code, le correcteur
 #: répond) : pas de figure à curseurs — l'interactivité d'un TD est le calcul à la main, celle d'un TP le
 #: code de l'étudiant et le verdict de practice.check. Objectifs, « À retenir » et quiz restent exigés.
-PRACTICE_PAGES = {p.stem for p in (Path(__file__).resolve().parent.parent / "book").glob("t[dp]-*.md")}
+PRACTICE_PAGES = {p.stem for p in (Path(__file__).resolve().parent.parent / "book").glob("t[dp]-*.md")} | {
+    "sujet-examen"}  # le sujet d'examen : une page d'exercices, comme un TD
 
 
 def _pages() -> list[str]:

@@ -5,7 +5,7 @@ r"""Extension Sphinx du livre : les encadrés de sphinx-proof en français, sur 
 - **Démonstrations** (``{prf:proof}``) : sphinx-proof écrit « Proof. » en tête de la première ligne, en
   anglais, et ne donne pas de titre à l'encadré. Ici, l'encadré reçoit le titre « Démonstration » et perd
   le « Proof. » ; avec ``:class: dropdown``, il est replié (sphinx-togglebutton, dont le bouton est le
-  titre de l'encadré) :
+  titre de l'encadré). Le symbole ∎ clôt la démonstration (□ dans le PDF, dont les polices n'ont pas ∎) :
 
   .. code-block:: markdown
 
@@ -43,6 +43,10 @@ def french_proofs(document) -> int:
                 continue
             if not any(isinstance(c, nodes.title) for c in box.children):
                 box.insert(0, nodes.title(PROOF_TITLE, PROOF_TITLE))
+                paragraphs = list(box.findall(nodes.paragraph))
+                if paragraphs:  # le symbole de fin, une fois (l'encadré vient de recevoir son titre)
+                    paragraphs[-1] += nodes.raw("", " ∎", format="html")
+                    paragraphs[-1] += nodes.raw("", r"\hfill\(\square\)", format="latex")
             if box["ids"] == ["proof"]:  # sphinx-proof donne à toutes le même identifiant : un par encadré
                 box["ids"] = []
                 document.set_id(box, suggested_prefix="demonstration")
