@@ -204,3 +204,48 @@ def exam_stationary_figure():
     ax.legend(loc="upper right", fontsize=8)
     ax.grid(alpha=0.3)
     return fig
+
+
+@register("td-ekf-invariant", chapter="td-filtrage-invariant",
+          title="TD 6 : l'exponentielle de SE(2) à la main, puis une correction de l'EKF invariant")
+def se2_by_hand_figure():
+    from ..geometry.lie import se2_exp
+    from ..scenarios.tutorials import SE2_BY_HAND, se2_by_hand
+    from .invariant import _robot
+
+    c, r = SE2_BY_HAND, se2_by_hand()
+    s = np.linspace(0.0, 1.0, 41)
+    fig, (ax1, ax2) = new_figure(1, 2, width=8.0, height=3.9)
+    xi = np.array(c["xi"])
+    arc = np.array([se2_exp(si * xi)[:2, 2] for si in s])
+    ax1.plot(arc[:, 0], arc[:, 1], color="tab:blue", lw=2.0, label="Exp(sξ), s de 0 à 1 : un quart de cercle")
+    _robot(ax1, np.eye(3), "black", size=0.12)
+    _robot(ax1, r.exp, "tab:blue", size=0.12)
+    ax1.plot([1.0], [0.0], "x", color="tab:red", ms=8, mew=2, label="(1 ; 0) : V(θ) oublié")
+    ax1.plot([0.0], [1.0], "+", color="tab:orange", ms=10, mew=2, label="(0 ; 1) : tourner, puis avancer")
+    ax1.set_xlim(-0.3, 1.3)
+    ax1.set_ylim(-0.3, 1.45)
+    ax1.set_title(f"Exercice 1 : arrivée en ({_fr(r.exp[0, 2])} ; {_fr(r.exp[1, 2])})", fontsize=9)
+    T_pred = np.array(c["T_pred"])
+    step = np.array([(T_pred @ se2_exp(si * r.update.K @ r.update.innovation))[:2, 2] for si in s])
+    y = np.array(c["y"])
+    circle = y + c["gnss_std"] * np.c_[np.cos(2 * np.pi * s), np.sin(2 * np.pi * s)]
+    ax2.plot(circle[:, 0], circle[:, 1], color="tab:red", lw=1.0, ls=":")
+    ax2.plot(*y, "o", color="tab:red", label=f"GNSS y = ({_fr(y[0])} ; {_fr(y[1])}), σ = {_fr(c['gnss_std'])} m")
+    ax2.plot(step[:, 0], step[:, 1], color="tab:purple", lw=1.5, ls="--", label="T̂ Exp(s Kz), s de 0 à 1")
+    _robot(ax2, T_pred, "tab:gray", size=0.3)
+    _robot(ax2, np.asarray(r.update.T), "tab:purple", size=0.3)
+    ax2.text(T_pred[0, 2] + 0.25, T_pred[1, 2] - 0.1, "prédite (cap 90°)", fontsize=8, color="0.3")
+    ax2.text(r.update.T[0, 2] - 0.2, r.update.T[1, 2] - 0.45, "corrigée (cap 180°)", fontsize=8,
+             color="tab:purple", ha="center")
+    ax2.set_xlim(1.4, 4.4)
+    ax2.set_ylim(0.2, 4.3)
+    ax2.set_title("Exercice 2 : la mesure est devant le robot,\nle cap tourne par la corrélation de P⁻",
+                  fontsize=9)
+    for ax in (ax1, ax2):
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.legend(fontsize=7, loc="upper left")
+        ax.grid(alpha=0.3)
+    return fig
