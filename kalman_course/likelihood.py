@@ -70,6 +70,7 @@ from .filters.diffuse import (
 )
 from .filters.engine import run_filter
 from .filters.ensemble import EnsembleFilterResult
+from .filters.imm import IMMResult
 from .filters.kalman import kalman_filter
 from .filters.particle import ParticleFilterResult
 from .filters.smoothers import diffuse_rts_pass, rts_smoother
@@ -101,16 +102,19 @@ def log_likelihood_terms(result: FilterResult) -> np.ndarray:
     :math:`\nu_k^TS_k^{-1}\nu_k = \lVert L_k^{-1}\nu_k\rVert^2`), sur les composantes observées.
 
     Paramètres : ``result`` — :class:`~kalman_course.FilterResult`. Renvoie (T,) : 0 pour un pas sans
-    mesure ; NaN pour un pas observé dont la prédiction n'est pas déterminée (début d'une initialisation diffuse,
-    SRIF parti de :math:`\mathcal R_{xx} = 0`).
+    mesure ou dont la mesure a été rejetée par la porte (``result.rejected`` : le filtre ne l'a pas utilisée,
+    comme une mesure manquante) ; NaN pour un pas observé dont la prédiction n'est pas déterminée (début d'une
+    initialisation diffuse, SRIF parti de :math:`\mathcal R_{xx} = 0`).
 
+    IMM : ses propres termes :math:`\log\sum_j \bar c_j\,\mathcal N(\nu_j; 0, S_j)` (vraisemblance du mélange,
+    ``result.log_likelihood_increments``), et non ceux de la gaussienne de mêmes moments.
     Filtres de Monte-Carlo : le filtre particulaire a sa propre estimation
     :math:`\log\hat p(y_k\mid y_{1:k-1})` (``result.log_likelihood_increments``), rendue telle quelle ;
     l'EnKF n'en a pas, et la formule gaussienne appliquée à ses innovations n'en serait qu'un substitut :
     refusé (:func:`filter_log_likelihood`).
     """
     result = _own_estimate_or_refuse(result, "log_likelihood_terms")
-    if isinstance(result, ParticleFilterResult):
+    if isinstance(result, (ParticleFilterResult, IMMResult)):
         return np.array(result.log_likelihood_increments, dtype=float)
     nu, S, obs = result.innovation, result.S, np.asarray(result.observed, dtype=bool)
     if nu.ndim != 2 or S.shape != nu.shape + nu.shape[-1:]:
@@ -120,7 +124,7 @@ def log_likelihood_terms(result: FilterResult) -> np.ndarray:
         )
     T = nu.shape[0]
     out = np.zeros(T)
-    rows = obs.any(axis=1)
+    rows = obs.any(axis=1) & ~np.asarray(result.rejected)  # une mesure rejetée par la porte ne compte pas
     known = rows & np.isfinite(np.where(obs, nu, 0.0)).all(axis=1)
     out[rows & ~known] = np.nan
     if known.any():
@@ -145,6 +149,10 @@ def filter_log_likelihood(result: FilterResult) -> float:
       (:func:`log_likelihood_terms`) ;
     * :class:`~kalman_course.filters.diffuse.DiffuseFilterResult` : la vraisemblance diffuse exacte
       :math:`\log L_d` (voir le module), à partir du filtre augmenté ;
+    * :class:`~kalman_course.IMMResult` : la vraisemblance du mélange,
+      :math:`\sum_k\log\sum_j \bar c_j\,\mathcal N(\nu_j; 0, S_j)` (``result.log_likelihood``) ;
+    * un filtre à porte (``gate=p``) : les pas rejetés (``result.rejected``) ne comptent pas, comme des
+      mesures manquantes ;
     * :class:`~kalman_course.ParticleFilterResult` : l'estimation du filtre particulaire lui-même,
       :math:`\log\hat p(y_{1:T}) = \sum_k\log\hat p(y_k\mid y_{1:k-1})` (``result.log_likelihood``) ;
     * :class:`~kalman_course.EnsembleFilterResult` : refusé — l'EnKF n'estime pas la vraisemblance, et la
@@ -155,7 +163,7 @@ def filter_log_likelihood(result: FilterResult) -> float:
     propres innovations et covariances :math:`S_k` (pour l'EKF, la vraisemblance de son modèle linéarisé).
     """
     result = _own_estimate_or_refuse(result, "filter_log_likelihood")
-    if isinstance(result, ParticleFilterResult):
+    if isinstance(result, (ParticleFilterResult, IMMResult)):
         return result.log_likelihood
     if isinstance(result, DiffuseFilterResult):
         return _diffuse_value(result.augmented, result.information[-1], result.information_vector[-1])
@@ -601,14 +609,15 @@ def _initial_noise_moment(model: LinearGaussianModel, res: FilterResult, x_smoot
 def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.ndarray | None):
     r"""Une itération d'EM : filtre, lisseur (étape E), formules closes (étape M).
 
-    Étape M, avec :math:`\hat x_{k\mid T}`, :math:`P_{k\mid T}`, :math:`P_{k,k-1\mid T}` du lisseur :
+    Étape M, avec :math:`\hat x_{k\mid T}`, :math:`P_{k\mid T}`, :math:`P_{k,k-1\mid T}` du lisseur (un modèle
+    variable dans le temps a ses :math:`A_k, B_k, C_k` ; :math:`Q` et :math:`R` sont constantes) :
 
     .. math::
 
-        Q' = \frac1{N_Q}\sum_k \Big[r_kr_k^T + P_{k\mid T} - P_{k,k-1\mid T}A^T - AP_{k,k-1\mid T}^T
-        + AP_{k-1\mid T}A^T\Big],\quad r_k = \hat x_{k\mid T} - A\hat x_{k-1\mid T} - Bu_{k-1},
+        Q' = \frac1{N_Q}\sum_k \Big[r_kr_k^T + P_{k\mid T} - P_{k,k-1\mid T}A_k^T - A_kP_{k,k-1\mid T}^T
+        + A_kP_{k-1\mid T}A_k^T\Big],\quad r_k = \hat x_{k\mid T} - A_k\hat x_{k-1\mid T} - B_ku_{k-1},
 
-        R' = \frac1T\sum_k \Big[e_ke_k^T + CP_{k\mid T}C^T\Big],\quad e_k = y_k - C\hat x_{k\mid T},
+        R' = \frac1T\sum_k \Big[e_ke_k^T + C_kP_{k\mid T}C_k^T\Big],\quad e_k = y_k - C_k\hat x_{k\mid T},
 
     la somme sur :math:`Q` portant sur les :math:`N_Q` transitions (depuis l'état initial si l'a priori est
     connu, terme calculé par le lissage des bruits, :func:`_initial_noise_moment`, sûr pour un a priori
@@ -635,31 +644,35 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
         augmented = run_filter(diffuse_family(), model, Y, None, None, U)
         J, h = diffuse_information(model, augmented)
         ll = _diffuse_value(augmented, J[-1], h[-1])  # vérifie que J_T est inversible
-        xs, Ps, lag = diffuse_rts_pass(model.A, augmented, J[-1], h[-1])
+        xs, Ps, lag = diffuse_rts_pass(np.asarray(model.sequence("A", Y.shape[0])), augmented, J[-1], h[-1])
         known_prior = False
-    A, C, R = model.A, model.C, model.R
     T, m = Y.shape
-    Bu = np.zeros_like(xs) if U is None else U @ model.B.T
-    # transitions k-1 → k, k = 1…T-1 : E[w wᵀ | y] = r rᵀ + P_{k|T} − P_{k,k-1|T}Aᵀ − A P_{k,k-1|T}ᵀ + A P_{k-1|T} Aᵀ
+    A, C = np.asarray(model.sequence("A", T)), np.asarray(model.sequence("C", T))  # (T, …) : A_k, C_k
+    R = model.R
+    Bu = np.zeros_like(xs) if U is None else (np.asarray(model.sequence("B", T)) @ U[:, :, None])[:, :, 0]
+    # transitions k-1 → k, k = 1…T-1 :
+    # E[w wᵀ | y] = r rᵀ + P_{k|T} − P_{k,k-1|T}A_kᵀ − A_k P_{k,k-1|T}ᵀ + A_k P_{k-1|T} A_kᵀ
     if xs.shape[0] < 2 and not known_prior:
         raise KalmanInputError("Il faut au moins deux pas de mesure pour estimer Q par EM sans a priori.")
-    r = xs[1:] - xs[:-1] @ A.T - Bu[1:]
-    LA = lag[1:] @ A.T
-    terms_Q = r[:, :, None] * r[:, None, :] + Ps[1:] - LA - np.swapaxes(LA, 1, 2) + A @ Ps[:-1] @ A.T
+    Ak, Akt = A[1:], np.swapaxes(A[1:], 1, 2)
+    r = xs[1:] - (Ak @ xs[:-1, :, None])[:, :, 0] - Bu[1:]
+    LA = lag[1:] @ Akt
+    terms_Q = r[:, :, None] * r[:, None, :] + Ps[1:] - LA - np.swapaxes(LA, 1, 2) + Ak @ Ps[:-1] @ Akt
     if known_prior:  # et la transition 0 → 1 depuis l'a priori
-        terms_Q = np.concatenate([_initial_noise_moment(model, res, xs[0], Ps[0])[None], terms_Q])
+        terms_Q = np.concatenate([_initial_noise_moment(model.at(0), res, xs[0], Ps[0])[None], terms_Q])
     Q_new = np.mean(terms_Q, axis=0)
     # mesures
     obs = ~np.isnan(Y)
     terms = np.empty((T, m, m))
     full, none = obs.all(axis=1), ~obs.any(axis=1)
-    e = Y[full] - xs[full] @ C.T  # lignes complètes, d'un bloc
-    terms[full] = e[:, :, None] * e[:, None, :] + C @ Ps[full] @ C.T
+    Cf = C[full]
+    e = Y[full] - (Cf @ xs[full][:, :, None])[:, :, 0]  # lignes complètes, d'un bloc
+    terms[full] = e[:, :, None] * e[:, None, :] + Cf @ Ps[full] @ np.swapaxes(Cf, 1, 2)
     terms[none] = R
     for k in np.flatnonzero(~full & ~none):  # lignes partielles
         o = obs[k]
         io, im = np.flatnonzero(o), np.flatnonzero(~o)
-        Co = C[io]
+        Co = C[k][io]
         e = Y[k, io] - Co.dot(xs[k])
         Eo = np.outer(e, e) + Co.dot(Ps[k]).dot(Co.T)
         Roo, Rmo = R[np.ix_(io, io)], R[np.ix_(im, io)]
@@ -671,7 +684,7 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
         block[np.ix_(im, im)] = R[np.ix_(im, im)] - W.dot(Rmo.T)
         terms[k] = M.dot(Eo).dot(M.T) + block
     R_new = terms.mean(axis=0)
-    new = LinearGaussianModel(A, C, symmetrize(Q_new), symmetrize(R_new), model.B)
+    new = LinearGaussianModel(model.A, model.C, symmetrize(Q_new), symmetrize(R_new), model.B)
     return ll, new
 
 
@@ -696,7 +709,8 @@ def expectation_maximization(
 
     Paramètres
     ----------
-    model : LinearGaussianModel — point de départ (ses :math:`Q`, :math:`R` initiales).
+    model : LinearGaussianModel — point de départ (ses :math:`Q`, :math:`R` initiales, constantes ; :math:`A`,
+        :math:`B`, :math:`C` peuvent varier dans le temps).
     y : (T, m), ou (T,) si m = 1 ; ``NaN`` : manquante.
     x0, P0 : a priori connu (sinon initialisation diffuse exacte), comme :func:`log_likelihood`.
     u : (T, p), optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
@@ -705,11 +719,12 @@ def expectation_maximization(
     Renvoie un :class:`EMResult`.
     """
     check_instance("model", model, LinearGaussianModel, "EM estime Q et R d'un modèle linéaire gaussien")
-    if model.time_varying:
+    if model.Q.ndim == 3 or model.R.ndim == 3:
+        name = "Q" if model.Q.ndim == 3 else "R"
         raise KalmanInputError(
-            "« model » varie dans le temps : EM estime une seule paire (Q, R) constante et n'accepte qu'un "
-            "modèle constant (pour des pas irréguliers, estimez plutôt la densité du bruit par "
-            "maximum_likelihood)."
+            f"« model » a une covariance « {name} » variable dans le temps : EM estime une seule paire (Q, R) "
+            "constante (A, B et C peuvent varier d'un pas à l'autre) ; pour des pas irréguliers, dont Q dépend, "
+            "estimez plutôt la densité du bruit par maximum_likelihood."
         )
     if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
         raise KalmanInputError(f"« max_iter » doit être un entier ≥ 1 ; reçu {max_iter!r}.")
