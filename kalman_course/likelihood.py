@@ -48,7 +48,7 @@ import scipy.differentiate
 import scipy.linalg
 import scipy.optimize
 
-from .core.linalg import S_NOT_PD, symmetrize
+from .core.linalg import symmetrize
 from .core.models import LinearGaussianModel
 from .core.results import FilterResult, freeze
 from .core.validation import (
@@ -68,7 +68,7 @@ from .filters.diffuse import (
     is_determined,
     masked_innovations,
 )
-from .filters.engine import run_filter
+from .filters.engine import run_filter, run_filter_runs
 from .filters.ensemble import EnsembleFilterResult
 from .filters.imm import IMMResult
 from .filters.kalman import kalman_filter
@@ -122,10 +122,16 @@ def log_likelihood_terms(result: FilterResult) -> np.ndarray:
             f"« result » doit porter des innovations (T, m) et leurs covariances (T, m, m) ; reçu "
             f"{nu.shape} et {S.shape} (un lot de tirages se traite tirage par tirage)."
         )
-    T = nu.shape[0]
-    out = np.zeros(T)
-    rows = obs.any(axis=1) & ~np.asarray(result.rejected)  # une mesure rejetée par la porte ne compte pas
-    known = rows & np.isfinite(np.where(obs, nu, 0.0)).all(axis=1)
+    return _prediction_error_terms(nu, S, obs & ~np.asarray(result.rejected)[:, None])
+
+
+def _prediction_error_terms(nu: np.ndarray, S: np.ndarray, obs: np.ndarray) -> np.ndarray:
+    r"""Les termes :math:`\ell_k` (…, T) d'innovations ``nu`` (…, T, m) de covariances ``S`` (…, T, m, m) aux
+    composantes observées ``obs`` (…, T, m) : 0 sans composante observée, NaN si l'innovation observée n'est
+    pas finie (prédiction non déterminée)."""
+    out = np.zeros(obs.shape[:-1])
+    rows = obs.any(axis=-1)
+    known = rows & np.isfinite(np.where(obs, nu, 0.0)).all(axis=-1)
     out[rows & ~known] = np.nan
     if known.any():
         v, S_full = masked_innovations(nu[known], S[known], obs[known])
@@ -196,18 +202,24 @@ def _own_estimate_or_refuse(result: Any, call: str) -> FilterResult:
     return result
 
 
-def _diffuse_value(augmented: FilterResult, J: np.ndarray, h: np.ndarray) -> float:
+def _diffuse_value(augmented: FilterResult, J: np.ndarray, h: np.ndarray):
     r""":math:`\log L_d` à partir du filtre augmenté et de :math:`J_T`, :math:`h_T` (voir le module) :
-    :math:`\sum_k \ell_k(v_k, S_k) + \tfrac12 h_T^TJ_T^{-1}h_T - \tfrac12\log|J_T|`, par Cholesky de :math:`J_T`."""
-    if not is_determined(J):
+    :math:`\sum_k \ell_k(v_k, S_k) + \tfrac12 h_T^TJ_T^{-1}h_T - \tfrac12\log|J_T|`, par Cholesky de :math:`J_T`.
+    Un lot (``augmented`` de :func:`~kalman_course.filters.engine.run_filter_runs`, ``J`` (N, n, n), ``h``
+    (N, n)) : les N valeurs, (N,)."""
+    det = is_determined(J)
+    if not np.all(det):
+        which = f" pour « models[{int(np.argmin(det))}] »" if np.ndim(det) else ""
         raise KalmanInputError(
-            "Les mesures ne déterminent pas l'état (information J_T singulière : modèle non observable "
+            f"Les mesures ne déterminent pas l'état{which} (information J_T singulière : modèle non observable "
             "ou trop peu de mesures) : la vraisemblance diffuse n'est pas définie."
         )
-    base = float(np.sum(log_likelihood_terms(augmented)))
-    L = scipy.linalg.cholesky(J, lower=True)
-    w = scipy.linalg.solve_triangular(L, h, lower=True)
-    return base + 0.5 * float(w @ w) - float(np.sum(np.log(np.diag(L))))
+    terms = _prediction_error_terms(augmented.innovation, augmented.S, np.asarray(augmented.observed, dtype=bool))
+    L = np.linalg.cholesky(J)
+    w = np.linalg.solve(L, h[..., None])[..., 0]
+    value = (np.sum(terms, axis=-1) + 0.5 * np.sum(w * w, axis=-1)
+             - np.sum(np.log(np.diagonal(L, axis1=-2, axis2=-1)), axis=-1))
+    return float(value) if np.ndim(value) == 0 else value
 
 
 def _prior(x0: Any, P0: Any) -> bool:
@@ -263,96 +275,30 @@ def log_likelihoods(models: Any, y: Any) -> np.ndarray:
     r"""Vraisemblances **diffuses exactes** de plusieurs modèles de mêmes dimensions sur les mêmes mesures,
     calculées en lot (une grille de paramètres, les points d'une hessienne).
 
-    Même calcul que :func:`log_likelihood` sans ``x0`` ni ``P0`` (voir le module), mais la récurrence du
-    filtre augmenté :math:`[a \mid X]` porte sur les ``G`` modèles à la fois (tableaux (G, …)) : à chaque
-    pas, :math:`[a^- \mid X^-] = A[a \mid X]`, :math:`P^- = AP A^T + Q`, puis, si ``y[k]`` est observée,
-    :math:`S = CP^-C^T + R = LL^T` (Cholesky), :math:`[v \mid -E] = [y \mid 0] - C[a^- \mid X^-]`,
-    :math:`K = P^-C^TS^{-1}`, :math:`[a \mid X] = [a^- \mid X^-] + K[v \mid -E]`, :math:`P = P^- - KCP^-`,
-    en cumulant :math:`\sum\log|S_k|`, :math:`\sum v_k^TS_k^{-1}v_k`, :math:`J = \sum E_k^TS_k^{-1}E_k`,
-    :math:`h = \sum E_k^TS_k^{-1}v_k`.
+    Même calcul que :func:`log_likelihood` sans ``x0`` ni ``P0`` (voir le module), par le même filtre
+    augmenté (:func:`~kalman_course.filters.diffuse.diffuse_family`), que le mode en lot du moteur
+    (:func:`~kalman_course.filters.engine.run_filter_runs`) fait tourner sur les ``G`` modèles à la fois : les
+    modèles sont empilés (:class:`~kalman_course.core.models.ModelBatch`, un tirage par modèle, tous sur
+    ``y``), puis :math:`J_T`, :math:`h_T` et :math:`\log L_d` sont formés pour tous les modèles en lot.
 
     Paramètres
     ----------
     models : suite de ``G`` :class:`~kalman_course.LinearGaussianModel` de mêmes ``n`` et ``m``, sans
-        commande.
-    y : (T, m), ou (T,) si m = 1 — ``NaN`` : mesure manquante. Une ligne partiellement observée fait
-        calculer chaque modèle par :func:`log_likelihood` (même résultat, sans le lot).
+        commande (des modèles variables dans le temps sont calculés un à un par :func:`log_likelihood`).
+    y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante (lignes entières ou partielles).
 
     Renvoie (G,) : les :math:`\log L_d` (nats), égales à celles de :func:`log_likelihood` aux arrondis près.
     """
-    models = list(models) if not isinstance(models, LinearGaussianModel) else [models]
-    if not models:
-        raise KalmanInputError("« models » doit contenir au moins un modèle.")
-    for i, model in enumerate(models):
-        check_instance(f"models[{i}]", model, LinearGaussianModel, "la vraisemblance est celle d'un modèle linéaire gaussien")
-    n, m = models[0].n_state, models[0].n_obs
-    for i, model in enumerate(models):
-        if model.n_state != n or model.n_obs != m:
-            raise KalmanInputError(
-                f"« models[{i}] » a n = {model.n_state}, m = {model.n_obs} ; le premier modèle a n = {n}, m = {m} : "
-                "le lot demande des modèles de mêmes dimensions."
-            )
-        if model.B is not None:
-            raise KalmanInputError(f"« models[{i}] » a une commande B : le lot n'en prend pas ; utilisez log_likelihood.")
-    Y = as_measurements("y", y, m)
-    obs = ~np.isnan(Y)
-    full, some = obs.all(axis=1), obs.any(axis=1)
-    if (some & ~full).any() or any(model.time_varying for model in models):
-        # lignes partielles ou modèles variables dans le temps : le calcul modèle par modèle
-        return np.array([log_likelihood(model, Y) for model in models])
-    A = np.stack([model.A for model in models])
-    C = np.stack([model.C for model in models])
-    Q = np.stack([model.Q for model in models])
-    R = np.stack([model.R for model in models])
-    G = len(models)
-    At, Ct = np.swapaxes(A, 1, 2), np.swapaxes(C, 1, 2)
-    xa = None
-    logdet = np.zeros(G)
-    quad = np.zeros(G)
-    J = np.zeros((G, n, n))
-    h = np.zeros((G, n))
-    n_obs = 0
-    for k in range(Y.shape[0]):
-        if xa is None:  # première prédiction : [a⁻ | X⁻] = [0 | I], P⁻ = 0
-            xa = np.zeros((G, n, n + 1))
-            xa[:, :, 1:] = np.eye(n)
-            P = np.zeros((G, n, n))
-        else:
-            xa = A @ xa
-            P = symmetrize(A @ P @ At + Q)
-        if not full[k]:
-            continue
-        V = -(C @ xa)  # [v | -E], (G, m, 1+n)
-        V[:, :, 0] += Y[k]
-        PCt = P @ Ct
-        S = C @ PCt + R
-        try:
-            L = np.linalg.cholesky(S)
-        except np.linalg.LinAlgError:
-            raise KalmanInputError(f"{S_NOT_PD[:-1]} (au pas {k}).") from None
-        W = np.linalg.solve(L, V)  # L⁻¹[v | -E]
-        logdet += 2.0 * np.sum(np.log(np.diagonal(L, axis1=1, axis2=2)), axis=1)
-        w = W[:, :, 0]
-        quad += np.sum(w * w, axis=1)
-        WE = W[:, :, 1:]  # -L⁻¹E
-        J += np.swapaxes(WE, 1, 2) @ WE
-        h -= (np.swapaxes(WE, 1, 2) @ w[:, :, None])[:, :, 0]
-        Kt = np.linalg.solve(np.swapaxes(L, 1, 2), np.linalg.solve(L, np.swapaxes(PCt, 1, 2)))  # Kᵀ = S⁻¹CP⁻ par Cholesky
-        K = np.swapaxes(Kt, 1, 2)
-        xa = xa + K @ V
-        P = symmetrize(P - K @ np.swapaxes(PCt, 1, 2))
-        n_obs += m
-    J = symmetrize(J)
-    det = is_determined(J)
-    if not det.all():
-        raise KalmanInputError(
-            f"Les mesures ne déterminent pas l'état pour « models[{int(np.argmin(det))}] » (information J_T "
-            "singulière : modèle non observable ou trop peu de mesures) : la vraisemblance diffuse n'est pas définie."
-        )
-    LJ = np.linalg.cholesky(J)
-    wJ = np.linalg.solve(LJ, h[:, :, None])[:, :, 0]
-    return (-0.5 * (n_obs * LOG_2PI + logdet + quad) + 0.5 * np.sum(wJ * wJ, axis=1)
-            - np.sum(np.log(np.diagonal(LJ, axis1=1, axis2=2)), axis=1))
+    from .core.models import ModelBatch
+
+    models = [models] if isinstance(models, LinearGaussianModel) else list(models)
+    if any(isinstance(model, LinearGaussianModel) and model.time_varying and model.B is None for model in models):
+        return np.array([log_likelihood(model, y) for model in models])  # un modèle variable : un par un
+    batch = ModelBatch(models)
+    Y = as_measurements("y", y, batch.n_obs)
+    augmented = run_filter_runs(diffuse_family(), batch, np.broadcast_to(Y, (batch.n_models,) + Y.shape), None, None)
+    J, h = diffuse_information(batch, augmented)
+    return _diffuse_value(augmented, J[:, -1], h[:, -1])
 
 
 # --------------------------------------------------------------------------- maximum de vraisemblance

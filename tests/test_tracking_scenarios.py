@@ -196,7 +196,42 @@ def test_imm_probability_follows_the_helicopter_turns():
     h = man.helicopter_imm()
     assert h.correlation > 0.6
     assert h.prediction_rms < h.prediction_rms_single * 1.05
-    assert np.allclose(h.result.mu.sum(axis=1), 1.0)
+
+
+def test_helicopter_imm_equals_filterpy_with_per_step_matrices_and_sensors():
+    """L'IMM de l'hélicoptère (deux régimes variables dans le temps, capteurs de position et de vitesse à des
+    instants différents) contre IMMEstimator de filterpy : à chaque pas, chaque filtre reçoit F = A[k], Q =
+    Q[k] avant predict(), puis H et R restreints au capteur présent avant update(z). Probabilités des régimes
+    et estimation combinée à 10⁻⁹, et la probabilité du régime agité lue aux messages de vitesse."""
+    from filterpy.kalman import IMMEstimator, KalmanFilter
+
+    from kalman_course.scenarios.helicopter import fitted_parameters
+
+    h = man.helicopter_imm()
+    track = heli.helicopter_track("both")
+    _, sp, sv = fitted_parameters("both")
+    modes = [heli.helicopter_model(track, q, sp, sv) for q in (0.1, 30.0)]
+    filters = []
+    for _ in modes:
+        f = KalmanFilter(dim_x=4, dim_z=4)
+        f.x, f.P = np.asarray(track.x0).reshape(4, 1).copy(), np.array(track.P0)
+        filters.append(f)
+    imm = IMMEstimator(filters, np.array([0.95, 0.05]), man.imm_transition(0.05))
+    mus, xs = [], []
+    for k in range(len(track.y)):
+        for f, model in zip(imm.filters, modes):
+            f.F, f.Q = np.array(model.A[k]), np.array(model.Q[k])
+        imm.predict()
+        o = ~np.isnan(track.y[k])
+        for f, model in zip(imm.filters, modes):
+            f.H, f.R, f.dim_z = np.array(model.C)[o], np.array(model.R)[np.ix_(o, o)], int(o.sum())
+        imm.update(track.y[k, o].reshape(-1, 1))
+        mus.append(imm.mu.copy())
+        xs.append(imm.x.ravel().copy())
+    np.testing.assert_allclose(h.result.mu, mus, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(h.result.x, xs, rtol=1e-9, atol=1e-6)
+    rows = np.searchsorted(np.asarray(track.t), np.round(h.rate_t, 3))
+    np.testing.assert_allclose(h.mu_at_rate, np.array(mus)[rows, 1], rtol=1e-9, atol=1e-12)
 
 
 # --------------------------------------------------------------------------- curseurs, contre filterpy

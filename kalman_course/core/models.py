@@ -35,7 +35,7 @@ from .validation import (
     check_psd,
 )
 
-__all__ = ["TimeVarying", "LinearGaussianModel", "NonlinearModel", "model_steps", "scale_process_noise"]
+__all__ = ["TimeVarying", "LinearGaussianModel", "ModelBatch", "NonlinearModel", "model_steps", "scale_process_noise"]
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -274,6 +274,68 @@ def _each_step(name: str, value: Any, T: int | None, check: Callable[[str, Any],
         k = int(np.argmin(ok))
         check(f"{name}[{k}]", arr[k])  # lève l'erreur française de cette ligne
     return sym
+
+
+@dataclass(frozen=True, eq=False, init=False)
+class ModelBatch:
+    r"""``G`` modèles linéaires gaussiens constants de mêmes dimensions, sans commande, empilés pour être
+    filtrés **ensemble sur les mêmes mesures** par le mode en lot du moteur
+    (:func:`~kalman_course.filters.engine.run_filter_runs`, un tirage par modèle) : ``A`` (G, n, n), ``C``
+    (G, m, n), ``Q`` (G, n, n), ``R`` (G, m, m). Sert aux vraisemblances d'une grille de paramètres
+    (:func:`~kalman_course.likelihood.log_likelihoods`)."""
+
+    A: np.ndarray
+    C: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+
+    def __init__(self, models: Sequence[LinearGaussianModel]) -> None:
+        models = list(models)
+        if not models:
+            raise KalmanInputError("« models » doit contenir au moins un modèle.")
+        for i, model in enumerate(models):
+            if not isinstance(model, LinearGaussianModel):
+                raise KalmanInputError(
+                    f"« models[{i}] » doit être un LinearGaussianModel ; reçu {type(model).__name__} (la "
+                    "vraisemblance est celle d'un modèle linéaire gaussien)."
+                )
+        n, m = models[0].n_state, models[0].n_obs
+        for i, model in enumerate(models):
+            if model.n_state != n or model.n_obs != m:
+                raise KalmanInputError(
+                    f"« models[{i}] » a n = {model.n_state}, m = {model.n_obs} ; le premier modèle a n = {n}, "
+                    f"m = {m} : le lot demande des modèles de mêmes dimensions."
+                )
+            if model.B is not None:
+                raise KalmanInputError(
+                    f"« models[{i}] » a une commande B : le lot n'en prend pas ; utilisez log_likelihood.")
+            if model.time_varying:
+                raise KalmanInputError(
+                    f"« models[{i}] » varie dans le temps : le lot demande des modèles constants ; utilisez "
+                    "log_likelihood modèle par modèle."
+                )
+        for name in ("A", "C", "Q", "R"):
+            object.__setattr__(self, name, _readonly(np.stack([getattr(model, name) for model in models])))
+
+    @property
+    def n_models(self) -> int:
+        """Nombre ``G`` de modèles."""
+        return self.A.shape[0]
+
+    @property
+    def n_state(self) -> int:
+        return self.A.shape[-1]
+
+    @property
+    def n_obs(self) -> int:
+        return self.C.shape[-2]
+
+    n_control = 0
+    time_varying = False
+    B = None
+
+    def __repr__(self) -> str:
+        return f"ModelBatch({self.n_models} modèles, n={self.n_state}, m={self.n_obs})"
 
 
 def _constant_model(A, C, Q, R, B) -> LinearGaussianModel:

@@ -400,9 +400,9 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
     shared = family.shared_covariance and bool(full.all()) and np.ndim(P0) < 3
     state = family.prior_many(model, x0, P0, N, shared=True) if shared else family.prior_many(model, x0, P0, N)
     moments = family.moments
-    n = moments(state)[0].shape[-1]
+    shape, n = family.state_shape(model), family.tangent_dim(model)  # estimation (n,) ou matrice (filtre augmenté)
     lead = () if shared else (N,)  # axe des tirages des covariances, gains et S
-    xs, xps = np.empty((N, T, n)), np.empty((N, T, n))
+    xs, xps = np.empty((N, T) + shape), np.empty((N, T) + shape)
     Ps, Pps = np.empty(lead + (T, n, n)), np.empty(lead + (T, n, n))
     Ks = np.zeros(lead + (T, n, m))  # gain nul pour une composante manquante : aucune correction
     nus = np.full((N, T, m), np.nan)

@@ -433,8 +433,9 @@ def imm_filter(models: Sequence[Any], y: Any, x0: Any, P0: Any, u: Any = None, *
     """
     if transition is None:
         r = len(models) if isinstance(models, (list, tuple)) else 1
-        hint = (" La matrice donnée en cinquième position est prise pour les commandes « u » : écrivez "
-                "transition=… ." if u is not None and _looks_like_transition(u, r) else "")
+        hint = (" La matrice donnée en cinquième position, qui est la place des commandes « u », ressemble à une "
+                "matrice de transition : nommez-la, transition=Pi." if u is not None and _looks_like_transition(u, r)
+                else "")
         raise KalmanInputError(
             "« transition » manque : la matrice (r, r) des probabilités de changement de régime se donne par son "
             f"nom, imm_filter(models, y, x0, P0, transition=Pi, mu0=…).{hint}"

@@ -99,7 +99,7 @@ def parallel_agreement(n_steps: int = 2000, rng: Any = PARALLEL_SEED) -> Agreeme
     par = parallel_kalman_filter(model, y, PARALLEL_X0, PARALLEL_P0)
     fields = ("x", "P", "x_pred", "P_pred", "K", "innovation", "S")
     smooth_seq = rts_smoother(model, seq, PARALLEL_X0, PARALLEL_P0)
-    smooth_par = parallel_rts_smoother(model, y, PARALLEL_X0, PARALLEL_P0)
+    smooth_par = parallel_rts_smoother(model, par, PARALLEL_X0, PARALLEL_P0)
     ll = filter_log_likelihood(seq)
     return Agreement(n_steps=n_steps, filter_gap=_gap(par, seq, fields),
                      smoother_gap=_gap(smooth_par, smooth_seq, ("x", "P", "G")), loglik=ll,
