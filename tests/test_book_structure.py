@@ -549,3 +549,26 @@ def test_errata_entries_say_what_checks_them_in_words_then_name_the_test():
     assert len(entries) >= 70
     problems = [f"{entry.split(chr(10), 2)[1][:40]} : {p}" for entry in entries for p in verified_by_problems(entry)]
     assert not problems, "\n".join(problems)
+
+
+# --------------------------------------------------------------------------- pas d'inverse dans un chapitre (issue 32)
+
+_INVERSE = re.compile(r"\b(?:np|numpy|scipy)\.linalg\.inv\(|\bla\.inv\(")
+
+
+def inverse_problems(text: str) -> list[str]:
+    """Les cellules de code qui forment une inverse (``np.linalg.inv``) : le cours résout (``solve``,
+    Cholesky), il n'inverse jamais."""
+    return [cell.strip().splitlines()[0] for cell in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, re.S)
+            if _INVERSE.search(cell)]
+
+
+def test_inverse_check():
+    bad = "```{code-cell} ipython3\nK = P @ C.T @ np.linalg.inv(S)\n```\n"
+    good = "```{code-cell} ipython3\nK = np.linalg.solve(S, C @ P).T\n```\n"
+    assert inverse_problems(bad) and not inverse_problems(good)
+
+
+@pytest.mark.parametrize("page", TOC)
+def test_no_chapter_forms_an_inverse(page):
+    assert not inverse_problems(_text(page)), f"{page} : {inverse_problems(_text(page))}"

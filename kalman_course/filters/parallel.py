@@ -144,10 +144,17 @@ def scan_passes(T: int) -> int:
 # paient un appel par matrice). Un opérande (p, q) sans axe des éléments est commun à tous.
 
 
+#: En deçà de ce nombre d'éléments, un produit en colonnes est un seul appel à ``numpy.einsum`` (moins
+#: d'appels Python) ; au-delà, n³ opérations vectorielles, plus rapides sur de longs vecteurs.
+SMALL = 2048
+
+
 def _mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """Produit de piles en colonnes : (p, q[, N]) · (q, r[, N]) → (p, r, N)."""
     p, q, r = A.shape[0], A.shape[1], B.shape[1]
     N = A.shape[2] if A.ndim == 3 else B.shape[2]
+    if N <= SMALL:
+        return np.einsum("ij...,jk...->ik...", A, B)
     out = np.empty((p, r, N))
     for i in range(p):
         Ai = A[i]
@@ -162,6 +169,8 @@ def _mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 def _mv(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(p, q[, N]) · (q, N) → (p, N)."""
     p, q = A.shape[0], A.shape[1]
+    if v.shape[-1] <= SMALL:
+        return np.einsum("ijn,jn->in", A, v) if A.ndim == 3 else A.dot(v)
     out = np.empty((p, v.shape[-1]))
     for i in range(p):
         o = out[i]
@@ -235,7 +244,10 @@ class _Pivot(Exception):
 
 
 def _solve_safe(M: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """:func:`_solve`, et LAPACK pour les matrices dont un pivot est trop petit."""
+    """:func:`_solve`, et LAPACK pour les matrices dont un pivot est trop petit (et pour une petite pile, où
+    un appel LAPACK par matrice coûte moins que n³ opérations vectorielles)."""
+    if M.shape[-1] <= SMALL // 8:
+        return _columns(np.linalg.solve(_rows(M), _rows(R)))
     M0, R0 = M.copy(), R.copy()
     try:
         return _solve(M, R)
