@@ -334,7 +334,7 @@ def imm_family(linear: bool = True, rule: GaussianRule | None = None) -> FilterF
         X, P = np.empty_like(X0), np.empty_like(P0)
         k = state.k + 1
         for j, mj in enumerate(model.models):
-            X[j], P[j] = mode_predict(mj, X0[j], symmetrize(P0[j]), u, k)
+            X[j], P[j] = mode_predict(mj, X0[j], P0[j], u, k)
         return IMMState(X, P, cbar, cbar, k)
 
     def update(model: ModeSet, state: IMMState, y, idx):
@@ -368,7 +368,7 @@ def imm_family(linear: bool = True, rule: GaussianRule | None = None) -> FilterF
         S_mix = symmetrize(_weighted(cbar, S) + (E.T * cbar).dot(E))
         x_pred = cbar.dot(state.X)
         Pxy = _weighted(cbar, np.array(PCts)) - ((state.X - x_pred).T * cbar).dot(E)
-        K = scipy.linalg.solve(S_mix, Pxy.T, assume_a="pos").T
+        K = np.linalg.solve(S_mix, Pxy.T).T
         return IMMState(X, P, mu, cbar, state.k, increment, nis), Correction(K, nu_mix, S_mix)
 
     def moments(state: IMMState):
