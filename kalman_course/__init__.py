@@ -128,14 +128,14 @@ from .likelihood import (
     maximum_likelihood,
 )
 from .tables import Table
-# un seul filtre gaussien, des règles d'intégration (issue 22)
+# un seul filtre gaussien, des règles d'intégration
 from .filters.gaussian import GaussianRule, gaussian_filter, gaussian_filter_runs, gaussian_predict, gaussian_update
 from .filters.extended import Linearization
 from .filters.unscented import UnscentedRule
 from .filters.cubature import CubatureRule, cubature_kalman_filter, cubature_kalman_filter_runs
 from .filters.gauss_hermite import GaussHermiteRule, gauss_hermite_kalman_filter, gauss_hermite_kalman_filter_runs
 from .filters.posterior_linearization import iterated_posterior_linearization_filter
-# filtrer et lisser en parallèle dans le temps (issue 22)
+# filtrer et lisser en parallèle dans le temps
 from .filters.parallel import parallel_kalman_filter, parallel_rts_smoother
 # filtrage invariant sur SE(2) (issue 35)
 from .filters.invariant import (

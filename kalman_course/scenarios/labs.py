@@ -32,7 +32,7 @@ from ..filters.smoothers import rts_smoother
 from ..filters.unscented import unscented_kalman_filter
 from ..likelihood import expectation_maximization
 from ..practice.nonlinear import point_function
-from ._motion import cv_transition
+from ..core.motion import constant_velocity
 from .nile import NILE_DK_VARIANCES, local_level_model
 from .pendulum import pendulum_data, pendulum_model, pendulum_observation, pendulum_transition
 from .tag import TAG_RANGE_STD, tag_data, tag_model, tag_ranges
@@ -126,7 +126,7 @@ def tag_lab(update: Callable | None = None, ranges_jacobian: Callable | None = N
     model = tag_model()
     ref = extended_kalman_filter(model, data.y, data.x0, data.P0)
     anchors = np.array(data.anchors)
-    linear = LinearGaussianModel(cv_transition(data.dt), np.eye(1, 4), np.array(model.Q), 1.0)
+    linear = LinearGaussianModel(constant_velocity(data.dt, accel_std=0.0).A, np.eye(1, 4), np.array(model.Q), 1.0)
     R = TAG_RANGE_STD**2 * np.eye(anchors.shape[0])
 
     def h(x):
