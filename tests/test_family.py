@@ -489,6 +489,24 @@ def test_se2_filters_missing_rows_are_prediction_only(member):
 
 
 @pytest.mark.parametrize("member", SE2_MEMBERS, ids=lambda f: f.__name__)
+def test_se2_filters_gated_step_is_the_same_step_with_the_row_missing(member):
+    """La porte, option du moteur, sur les filtres de SE(2) : des positions aberrantes rejetées ; le filtrage à
+    porte égale le même filtrage où ces lignes manquent, log-vraisemblance comprise."""
+    model, _, T0, P0, u = _se2_case(T=60)
+    clean = member(model, np.full((60, 2), np.nan), T0, P0, u)
+    y = clean.position + np.random.default_rng(5).normal(0.0, 0.8, (60, 2))
+    y[[10, 30, 31]] += 40.0
+    gated = member(model, y, T0, P0, u, gate=0.999)
+    assert gated.rejected[[10, 30, 31]].all()
+    holes = y.copy()
+    holes[gated.rejected] = np.nan
+    plain = member(model, holes, T0, P0, u)
+    for field in ("x", "P", "x_pred", "P_pred"):
+        np.testing.assert_allclose(getattr(gated, field), getattr(plain, field), rtol=1e-8, atol=1e-10, err_msg=field)
+    assert kc.filter_log_likelihood(gated) == pytest.approx(kc.filter_log_likelihood(plain), rel=1e-10)
+
+
+@pytest.mark.parametrize("member", SE2_MEMBERS, ids=lambda f: f.__name__)
 @pytest.mark.parametrize("bad, message", BAD_INPUTS[:3] + BAD_INPUTS[7:])
 def test_se2_filters_share_the_engine_errors(member, bad, message):
     model, y, T0, P0, u = _se2_case(T=5)
