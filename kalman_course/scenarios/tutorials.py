@@ -200,7 +200,7 @@ def parallel_elements() -> dict:
     model = LinearGaussianModel(1.0, 1.0, c["Q"], c["R"])
     y = np.array(c["y"])[:, None]
     elements = filtering_elements(model, y, np.array([c["x0"]]), np.array([[c["P0"]]]), None)
-    pick = lambda e, k: tuple(a[k:k + 1] for a in e)  # noqa: E731
+    pick = lambda e, k: tuple(a[..., k:k + 1] for a in e)  # noqa: E731 (éléments en colonnes : axe du pas en dernier)
     scalar = lambda e: tuple(float(np.asarray(a).reshape(-1)[0]) for a in e)  # noqa: E731
     a1, a2, a3 = (pick(elements, k) for k in range(3))
     a12 = combine_filtering(a1, a2)
