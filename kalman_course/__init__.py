@@ -137,6 +137,10 @@ from .filters.gauss_hermite import GaussHermiteRule, gauss_hermite_kalman_filter
 from .filters.posterior_linearization import iterated_posterior_linearization_filter
 # filtrer et lisser en parallèle dans le temps (issue 22)
 from .filters.parallel import parallel_kalman_filter, parallel_rts_smoother
+# assimilation de données : Lorenz-63/96, ETKF, DEnKF, LETKF, 3D-Var, interpolation optimale (issue 33)
+from .core.lorenz import lorenz63, lorenz96
+from .filters.ensemble_analysis import denkf_update, etkf_update, gaspari_cohn, letkf_update
+from .filters.variational import optimal_interpolation, three_dimensional_var, var3d_update
 
 __all__ = [
     # modèles, résultats, erreurs
@@ -294,6 +298,16 @@ __all__ = [
     "iterated_posterior_linearization_filter",
     "parallel_kalman_filter",
     "parallel_rts_smoother",
+    # assimilation de données (issue 33)
+    "lorenz96",
+    "lorenz63",
+    "etkf_update",
+    "denkf_update",
+    "gaspari_cohn",
+    "letkf_update",
+    "var3d_update",
+    "three_dimensional_var",
+    "optimal_interpolation",
     # sous-modules
     "errata",
     "geometry",
