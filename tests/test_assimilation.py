@@ -220,15 +220,15 @@ def test_letkf_with_infinite_radius_is_the_etkf(N, n, m):
                                kc.etkf_update(E, y, H, R, inflation=1.2), atol=1e-10)
 
 
-@pytest.mark.parametrize("N, n, m", [(7, 15, 10), (14, 9, 6)], ids=["N ≤ m (espace de l'ensemble)",
-                                                              "N > m (espace des observations)"])
-def test_letkf_column_j_is_the_local_etkf_with_tapered_observations(N, n, m):
+@pytest.mark.parametrize("N, n, m, radius", [(7, 15, 10, 2.0), (14, 9, 6, 2.0), (12, 30, 20, 1.0), (4, 30, 20, 1.0)],
+                         ids=["N ≤ k (espace de l'ensemble)", "N > k = m (espace des observations)",
+                              "N > k, k < m (observations proches seulement)", "N ≤ k < m"])
+def test_letkf_column_j_is_the_local_etkf_with_tapered_observations(N, n, m, radius):
     """Chaque colonne j contre l'ETKF dense (sqrtm) calculé avec Ỹ diag(√ρ_j), diag(√ρ_j) d̃ et R = I, où
     Ỹ = Y R^{-1/2} et d̃ = R^{-1/2} d (racine symétrique de scipy)."""
     E, H, R, y = linear_case(5 + N, N, n, m)
     obs_at = np.linspace(0, n - 1, m)
     D = np.abs(obs_at[:, None] - np.arange(n)[None])
-    radius = 2.0
     Ea = kc.letkf_update(E, y, H, R, D, radius=radius, inflation=1.05)
     W = np.real(scipy.linalg.sqrtm(np.linalg.inv(R)))
     HE = E @ H.T

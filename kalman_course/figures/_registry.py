@@ -46,6 +46,10 @@ CHAPTER_TITLES: dict[str, str] = {
     "filtre-gaussien": "Un seul filtre gaussien : linéarisation, points sigma, cubature, Gauss–Hermite",
     "quel-filtre": "Quel filtre choisir ?",
     "filtrage-parallele": "Filtrer en parallèle dans le temps",
+    "assimilation-ensemble": "Le filtre d'ensemble en grande dimension",
+    "methodes-variationnelles": "Méthodes variationnelles",
+    "td-assimilation": "TD 4 — Assimilation de données à la main",
+    "tp-assimilation": "TP 5 — L'ETKF sur Lorenz-96",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

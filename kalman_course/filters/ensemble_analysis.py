@@ -247,36 +247,47 @@ def denkf_analysis(x_bar, A, Y, d, R, inflation: float = 1.0, K=None) -> np.ndar
 
 def letkf_analysis(x_bar, A, Y, d, R, rho, inflation: float = 1.0, W=None) -> np.ndarray:
     r"""Le LETKF sur des entrées déjà vérifiées ; ``rho`` (m, n) les poids :math:`\rho_{ij}` de
-    Gaspari–Cohn. Les :math:`n` analyses locales en lot, par un seul ``eigh`` sur une pile de :math:`n`
-    matrices : :math:`G_j = \tilde Y\operatorname{diag}(\rho_{\cdot j})\tilde Y^T` (N, N) si :math:`N \le m`,
-    sinon :math:`D_j\tilde Y^T\tilde YD_j` (m, m), :math:`D_j = \operatorname{diag}(\sqrt{\rho_{\cdot j}})`
-    (mêmes valeurs propres non nulles, mêmes formules que :func:`etkf_analysis`)."""
+    Gaspari–Cohn.
+
+    Chaque analyse locale ne garde que les observations de poids non nul (:math:`\rho_{ij} = 0` n'y change
+    rien : ce n'est pas une coupure), au plus :math:`k` par composante ; avec
+    :math:`Z_j = \tilde Y_{\cdot,\mathcal L_j}\operatorname{diag}(\sqrt{\rho_{\mathcal L_j j}})` (N, k) et
+    :math:`e_j = \sqrt{\rho_{\mathcal L_j j}} \circ \tilde d_{\mathcal L_j}`, les :math:`n` analyses sont faites
+    en lot, par un seul ``eigh`` sur une pile de :math:`n` matrices : :math:`Z_jZ_j^T` (N, N) si
+    :math:`N \le k`, sinon :math:`Z_j^TZ_j` (k, k) (mêmes valeurs propres non nulles, mêmes formules que
+    :func:`etkf_analysis`)."""
     W = symmetric_inverse_root(R) if W is None else W
     Yt, dt = Y.dot(W), W.dot(d)                         # (N, m), (m,)
-    N1, m = Yt.shape[0] - 1, Yt.shape[1]
-    if N1 + 1 <= m:
-        G = np.matmul(Yt[None, :, :] * rho.T[:, None, :], Yt.T)   # (n, N, N) : Ỹ diag(ρ_j) Ỹᵀ
-        s, V = np.linalg.eigh(G)                             # (n, N), (n, N, N)
-        s = np.clip(s, 0.0, None)
-        b = Yt.dot(rho * dt[:, None]).T                      # (n, N) : Ỹ_j d̃_j = Ỹ (ρ_j ∘ d̃)
-        Vt = np.swapaxes(V, 1, 2)
-        c = np.matmul(Vt, b[:, :, None])[:, :, 0] / (s + N1)  # Vᵀ Ỹ_j d̃_j / (s + N − 1)
-        w = np.matmul(V, c[:, :, None])[:, :, 0]             # (n, N)
-        increment = np.einsum("aj,ja->j", A, w)              # (n,) : colonne j de Kd
-        a = np.matmul(Vt, A.T[:, :, None])[:, :, 0] * np.sqrt(N1 / (s + N1))
-        TA = np.matmul(V, a[:, :, None])[:, :, 0].T          # (N, n) : colonne j = T_j A[:, j]
+    N1, n = Yt.shape[0] - 1, A.shape[1]
+    reach = rho > 0.0
+    k = max(int(reach.sum(axis=0).max()), 1)           # observations utiles d'une analyse locale, au plus
+    if k < rho.shape[0]:
+        local = np.argsort(~reach, axis=0, kind="stable")[:k]   # (k, n) : d'abord les poids non nuls
+        weight = np.sqrt(np.take_along_axis(rho, local, axis=0)).T  # (n, k), nuls pour le remplissage
+        Z = Yt[:, local.T] * weight[None]                # (N, n, k)
+        e = dt[local.T] * weight                         # (n, k)
     else:
-        root = np.sqrt(rho.T)                                # (n, m) : √ρ_j
-        G = Yt.T.dot(Yt)[None] * root[:, :, None] * root[:, None, :]   # (n, m, m) : D_j ỸᵀỸ D_j
-        s, Q = np.linalg.eigh(G)                             # (n, m), (n, m, m)
+        weight = np.sqrt(rho).T
+        Z = Yt[:, None, :] * weight[None]
+        e = dt[None, :] * weight
+    Z = np.swapaxes(Z, 0, 1)                             # (n, N, k) : Z_j
+    Zt = np.swapaxes(Z, 1, 2)
+    a = A.T[:, :, None]                                  # (n, N, 1) : A[:, j]
+    if N1 + 1 <= k:
+        s, V = np.linalg.eigh(np.matmul(Z, Zt))          # (n, N), (n, N, N)
+        s = np.clip(s, 0.0, None)
+        Vt = np.swapaxes(V, 1, 2)
+        w = np.matmul(V, np.matmul(Vt, np.matmul(Z, e[:, :, None])) / (s + N1)[:, :, None])  # (n, N, 1)
+        TA = np.matmul(V, np.matmul(Vt, a) * np.sqrt(N1 / (s + N1))[:, :, None])             # T_j A[:, j]
+    else:
+        s, Q = np.linalg.eigh(np.matmul(Zt, Z))          # (n, k), (n, k, k)
         s = np.clip(s, 0.0, None)
         Qt = np.swapaxes(Q, 1, 2)
-        c = root * Yt.T.dot(A).T                             # (n, m) : D_j Ỹᵀ A[:, j]
-        e = root * dt                                        # (n, m) : D_j d̃
-        increment = np.einsum("jm,jm->j", c, np.matmul(Q, (np.matmul(Qt, e[:, :, None])[:, :, 0] / (s + N1))[:, :, None])[:, :, 0])
-        u = root * np.matmul(Q, (_transform_minus_identity(s, N1) * np.matmul(Qt, c[:, :, None])[:, :, 0])[:, :, None])[:, :, 0]
-        TA = A + Yt.dot(u.T)                                 # (N, n) : colonne j = A[:, j] + Ỹ D_j Q_j g Q_jᵀ D_j Ỹᵀ A[:, j]
-    return x_bar + increment + inflation * TA
+        w = np.matmul(Z, np.matmul(Q, np.matmul(Qt, e[:, :, None]) / (s + N1)[:, :, None]))
+        g = _transform_minus_identity(s, N1)[:, :, None]
+        TA = a + np.matmul(Z, np.matmul(Q, g * np.matmul(Qt, np.matmul(Zt, a))))
+    increment = np.einsum("ja,ja->j", A.T, w[:, :, 0])   # (n,) : colonne j de Kd = A[:, j]·w_j
+    return x_bar + increment + inflation * TA[:, :, 0].T
 
 
 # --------------------------------------------------------------------------- fonctions publiques
@@ -303,11 +314,14 @@ def gaspari_cohn(distances: Any, radius: Any) -> np.ndarray:
     if math.isinf(r):
         return np.ones_like(d)
     z = d / (GASPARI_COHN_SCALE * r)
-    near = -0.25 * z**5 + 0.5 * z**4 + 0.625 * z**3 - (5.0 / 3.0) * z**2 + 1.0
-    with np.errstate(divide="ignore"):
-        far = z**5 / 12.0 - 0.5 * z**4 + 0.625 * z**3 + (5.0 / 3.0) * z**2 - 5.0 * z + 4.0 - 2.0 / (3.0 * z)
-    # ρ ≥ 0 sur [0, 2] ; le maximum efface l'arrondi (−3 × 10⁻¹⁶ en z = 2)
-    return np.maximum(np.where(z <= 1.0, near, np.where(z <= 2.0, far, 0.0)), 0.0)
+    rho = np.zeros_like(z)
+    near, far = z <= 1.0, (z > 1.0) & (z < 2.0)   # ρ = 0 dès z ≥ 2 : rien à calculer
+    a = z[near]
+    rho[near] = (((-0.25 * a + 0.5) * a + 0.625) * a - 5.0 / 3.0) * a * a + 1.0
+    b = z[far]
+    rho[far] = ((((b / 12.0 - 0.5) * b + 0.625) * b + 5.0 / 3.0) * b - 5.0) * b + 4.0 - 2.0 / (3.0 * b)
+    # ρ ≥ 0 sur [0, 2] ; le maximum efface l'arrondi près de z = 2
+    return np.maximum(rho, 0.0)
 
 
 def etkf_update(E: Any, y: Any, C: Any, R: Any, *, inflation: float = 1.0) -> np.ndarray:

@@ -31,6 +31,7 @@ from .linear import JOSEPH_UPDATE, KF_PREDICT, KF_UPDATE, NIS
 from .nonlinear import EKF_UPDATE, SO3_EXP, TAG_JACOBIAN
 from .sampling import PARTICLE_WEIGHTS, SIGMA_POINTS, SYSTEMATIC_RESAMPLE, UNSCENTED_TRANSFORM
 from .smoothing import EM_M_STEP, RTS_STEP
+from .assimilation import ETKF_UPDATE, GASPARI_COHN  # assimilation de données (issue 33)
 from .verdict import Verdict
 
 __all__ = ["Attempt", "Case", "Exercise", "Mistake", "Output", "Verdict", "attempt", "check", "exercise", "exercises",
@@ -41,6 +42,7 @@ _EXERCISES: tuple[Exercise, ...] = (
     EKF_UPDATE, TAG_JACOBIAN, SO3_EXP,
     SIGMA_POINTS, UNSCENTED_TRANSFORM, SYSTEMATIC_RESAMPLE, PARTICLE_WEIGHTS,
     RTS_STEP, EM_M_STEP,
+    ETKF_UPDATE, GASPARI_COHN,
 )
 _BY_ID = {ex.id: ex for ex in _EXERCISES}
 

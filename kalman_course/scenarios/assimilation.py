@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any, NamedTuple
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
@@ -54,9 +54,40 @@ __all__ = [
     "SHORT_BURN_IN",
     "TwinExperiment",
     "twin_experiment",
+    "STUDY_SEED",
+    "MAP_MEMBERS",
+    "MAP_INFLATIONS",
+    "LOCALIZATION_RADII",
+    "LOCALIZATION_MEMBERS",
+    "LOCALIZATION_INFLATION",
+    "DENSITY_SPACINGS",
+    "DENSITY_METHODS",
+    "DENSITY_SETTINGS",
+    "inflation_run",
+    "inflation_map",
+    "localization_run",
+    "density_run",
+    "density_table",
+    "SampleCorrelations",
+    "sample_correlations",
+    "Lorenz63Picture",
+    "lorenz63_picture",
+    "Lorenz96Picture",
+    "lorenz96_picture",
+    "variational_lorenz63",
+    "CostCase",
+    "var3d_cost_case",
+    "LAB_MEMBERS",
+    "LAB_INFLATION",
+    "LAB_CYCLES",
+    "LAB_RADIUS",
+    "LAB_SEED",
+    "etkf_lab",
     "DapperRow",
     "DAPPER_TABLE",
     "CONCLUSIVE_SHARE",
+    "dapper_table",
+    "cost_table",
     "tolerance",
     "verdict",
 ]
@@ -243,6 +274,241 @@ def short_experiment(method: str, *, rng: Any, n_members: int | None = None, inf
                        observed_every=int(observed_every))
 
 
+# --------------------------------------------------------------------------- études des chapitres (expériences courtes)
+
+#: Graine des expériences courtes des chapitres et de leurs curseurs.
+STUDY_SEED = 0
+#: Carte taille × inflation de l'EnKF stochastique (chapitre « Le filtre d'ensemble en grande dimension »).
+MAP_MEMBERS = (10, 15, 20, 30, 40)
+MAP_INFLATIONS = (1.0, 1.02, 1.06, 1.1, 1.2)
+#: Rayons de localisation du LETKF (7 membres, inflation 1,04, comme la ligne de DAPPER).
+LOCALIZATION_RADII = (1.0, 2.0, 4.0, 8.0, 16.0, np.inf)
+LOCALIZATION_MEMBERS, LOCALIZATION_INFLATION = 7, 1.04
+#: Densité d'observation (chapitre « Méthodes variationnelles ») : une variable observée sur k, et les
+#: réglages des trois méthodes comparées.
+DENSITY_SPACINGS = (1, 2, 4, 8)
+DENSITY_METHODS = ("letkf", "3dvar", "oi")
+DENSITY_SETTINGS = {
+    "letkf": ("etkf", {"n_members": 10, "inflation": 1.04, "localization": 4.0}),
+    "3dvar": ("3dvar", {"background_scale": 0.02}),
+    "oi": ("oi", {}),
+}
+
+
+@lru_cache(maxsize=None)
+def inflation_run(n_members: int, inflation: float) -> TwinExperiment:
+    """L'EnKF stochastique (expérience courte, :func:`short_experiment`) pour la carte taille × inflation."""
+    return short_experiment("stochastic", rng=STUDY_SEED, n_members=int(n_members), inflation=float(inflation))
+
+
+def inflation_map() -> np.ndarray:
+    """rmse.a (len(MAP_MEMBERS), len(MAP_INFLATIONS)) de l'EnKF stochastique : taille × inflation."""
+    return np.array([[inflation_run(N, lam).rmse_a for lam in MAP_INFLATIONS] for N in MAP_MEMBERS])
+
+
+@lru_cache(maxsize=None)
+def localization_run(radius: float) -> TwinExperiment:
+    """Le LETKF à 7 membres (expérience courte) de rayon ``radius`` (``numpy.inf`` : l'ETKF global)."""
+    return short_experiment("etkf", rng=STUDY_SEED, n_members=LOCALIZATION_MEMBERS,
+                            inflation=LOCALIZATION_INFLATION, localization=float(radius))
+
+
+@lru_cache(maxsize=None)
+def density_run(spacing: int, method: str) -> TwinExperiment:
+    """``method`` (``"letkf"``, ``"3dvar"`` ou ``"oi"``) avec une variable observée sur ``spacing``
+    (expérience courte)."""
+    name, settings = DENSITY_SETTINGS[method]
+    return short_experiment(name, rng=STUDY_SEED, observed_every=int(spacing), **settings)
+
+
+def density_table() -> np.ndarray:
+    """rmse.a (len(DENSITY_METHODS), len(DENSITY_SPACINGS))."""
+    return np.array([[density_run(k, m).rmse_a for k in DENSITY_SPACINGS] for m in DENSITY_METHODS])
+
+
+class SampleCorrelations(NamedTuple):
+    """Corrélations de la variable ``centre`` avec les 40 variables d'un ensemble prévu de Lorenz-96 :
+    ``reference`` (grand ensemble), ``small`` (les ``n_small`` premiers membres), ``tapered`` (``small``
+    multipliée par Gaspari–Cohn de rayon ``radius``), ``distance`` (distance sur l'anneau) ; ``rank`` :
+    rang de la covariance du petit ensemble."""
+
+    distance: np.ndarray
+    reference: np.ndarray
+    small: np.ndarray
+    tapered: np.ndarray
+    rank: int
+    n_small: int
+    n_large: int
+    radius: float
+    centre: int
+
+
+@lru_cache(maxsize=None)
+def sample_correlations(n_small: int = 10, n_large: int = 2000, radius: float = 4.0, centre: int = 20,
+                        cycles: int = 4) -> SampleCorrelations:
+    r"""Corrélations d'échantillon d'un ensemble prévu : ``n_large`` membres tirés autour d'un état de
+    l'attracteur (écart-type 0,5), prévus ``cycles`` cycles (les corrélations deviennent celles de
+    l'écoulement), puis corrélation de la variable ``centre`` avec chacune des 40 ; le petit ensemble en
+    est un sous-ensemble de ``n_small`` membres. Graine :data:`STUDY_SEED`."""
+    from ..filters.ensemble_analysis import gaspari_cohn
+
+    gen = np.random.default_rng(STUDY_SEED)
+    model = twin_system("lorenz96").model
+    E = np.asarray(attractor_start()) + 0.5 * gen.standard_normal((n_large, 40))
+    for _ in range(cycles):
+        E = model.f(E, None)
+
+    def row(X):
+        return np.corrcoef(X.T)[centre]
+
+    small = row(E[:n_small])
+    distance = ring_distances(40)[centre]
+    rank = int(np.linalg.matrix_rank(np.cov(E[:n_small].T)))
+    return SampleCorrelations(distance, row(E), small, small * gaspari_cohn(distance, radius), rank,
+                              n_small, n_large, radius, centre)
+
+
+class Lorenz63Picture(NamedTuple):
+    """L'attracteur de Lorenz-63 et une assimilation : ``path`` (M, 3) la vérité pas à pas (pas RK4 de 0,01),
+    ``experiment`` l'expérience jumelle (ETKF), ``free`` (K, 3) une prévision sans assimilation partie
+    à 10⁻³ près de la même vérité."""
+
+    path: np.ndarray
+    experiment: TwinExperiment
+    free: np.ndarray
+
+
+@lru_cache(maxsize=1)
+def lorenz63_picture(n_cycles: int = 120, n_members: int = 10, inflation: float = 1.02) -> Lorenz63Picture:
+    """ETKF à 10 membres sur Lorenz-63 (expérience courte : ``n_cycles`` cycles, 64 de mise en route), la
+    vérité entre deux cycles (25 pas RK4 de 0,01 chacun), et une prévision libre partie de la vérité
+    initiale décalée de 10⁻³."""
+    exp = twin_experiment("lorenz63", "etkf", rng=STUDY_SEED, n_members=n_members, inflation=inflation,
+                          n_cycles=n_cycles, burn_in=64)
+    fine = lorenz63(n_substeps=1)
+    path = [exp.x_true[0]]
+    for _ in range((n_cycles - 1) * 25):
+        path.append(fine.f(path[-1], None))
+    coarse = twin_system("lorenz63").model
+    free = [exp.x_true[0] + np.array([1e-3, 0.0, 0.0])]
+    for _ in range(n_cycles - 1):
+        free.append(coarse.f(free[-1], None))
+    return Lorenz63Picture(np.array(path), exp, np.array(free))
+
+
+class Lorenz96Picture(NamedTuple):
+    """Lorenz-96 en diagramme de Hovmöller : ``experiment`` (ETKF, expérience courte), ``free`` (K, 40) une
+    prévision libre partie de la vérité initiale décalée de 10⁻³ sur une variable."""
+
+    experiment: TwinExperiment
+    free: np.ndarray
+
+
+@lru_cache(maxsize=1)
+def lorenz96_picture() -> Lorenz96Picture:
+    """ETKF à 20 membres, inflation 1,04 (la ligne de DAPPER), expérience courte (:func:`short_experiment`),
+    et une prévision libre partie de la vérité du premier cycle décalée de 10⁻³ sur la variable 0."""
+    exp = short_experiment("etkf", rng=STUDY_SEED, n_members=20, inflation=1.04)
+    model = twin_system("lorenz96").model
+    free = [exp.x_true[0] + 1e-3 * np.eye(40)[0]]
+    for _ in range(exp.x_true.shape[0] - 1):
+        free.append(model.f(free[-1], None))
+    return Lorenz96Picture(exp, np.array(free))
+
+
+@lru_cache(maxsize=1)
+def variational_lorenz63() -> dict:
+    """Les deux lignes de Lorenz-63 du tableau (3D-Var, :math:`B = 0{,}1\\,\\Sigma`, et interpolation
+    optimale), 1000 cycles, graine :data:`STUDY_SEED` : nom → :class:`TwinExperiment`."""
+    return {"3dvar": twin_experiment("lorenz63", "3dvar", rng=STUDY_SEED, background_scale=0.1),
+            "oi": twin_experiment("lorenz63", "oi", rng=STUDY_SEED)}
+
+
+class CostCase(NamedTuple):
+    r"""Le 3D-Var en deux dimensions : ébauche ``x_b``, covariance ``B`` (corrélation 0,8 entre les deux
+    composantes), observation ``y`` (1,) de la première composante (``C`` (1, 2), ``R`` (1, 1)), analyse
+    ``x_a`` (:func:`~kalman_course.var3d_update`) et minimiseur ``x_numeric`` de :math:`J` trouvé par
+    ``scipy.optimize.minimize`` (BFGS, gradient donné)."""
+
+    x_b: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    R: np.ndarray
+    y: np.ndarray
+    x_a: np.ndarray
+    x_numeric: np.ndarray
+
+
+@lru_cache(maxsize=1)
+def var3d_cost_case() -> CostCase:
+    """Le cas de la figure « 3dvar-cout » du chapitre « Méthodes variationnelles »."""
+    import scipy.optimize
+
+    from ..filters.variational import var3d_update
+
+    x_b = np.array([0.0, 0.0])
+    B = np.array([[1.0, 0.8], [0.8, 1.0]])
+    C, R, y = np.array([[1.0, 0.0]]), np.array([[0.25]]), np.array([2.0])
+    Bi, Ri = np.linalg.inv(B), np.linalg.inv(R)
+
+    def cost(x):
+        return 0.5 * (x - x_b) @ Bi @ (x - x_b) + 0.5 * (y - C @ x) @ Ri @ (y - C @ x)
+
+    def grad(x):
+        return Bi @ (x - x_b) - C.T @ Ri @ (y - C @ x)
+
+    best = scipy.optimize.minimize(cost, x_b, jac=grad, method="BFGS", options={"gtol": 1e-12})
+    return CostCase(x_b, B, C, R, y, var3d_update(x_b, y, C, B, R), best.x)
+
+
+# --------------------------------------------------------------------------- TP : l'ETKF de l'étudiant
+
+#: Le TP de l'ETKF : membres, inflation, cycles, rayon du taper, graine.
+LAB_MEMBERS, LAB_INFLATION, LAB_CYCLES, LAB_RADIUS, LAB_SEED = 20, 1.04, 100, 4.0, 5
+
+
+def etkf_lab(etkf_update: Callable | None = None, gaspari_cohn: Callable | None = None):
+    r"""TP « L'ETKF sur Lorenz-96 » : un cycle d'assimilation écrit en boucle (prévision RK4 de l'ensemble,
+    analyse ``etkf_update(E, y, H, R, inflation)`` de l'étudiant, :math:`H = R = I`, 20 membres, inflation
+    1,04, 100 cycles, départ sur l'attracteur, ensemble initial :math:`\mathcal N(x_0, I)`), contre la même
+    boucle avec :func:`~kalman_course.etkf_update` ; et le taper ``gaspari_cohn(d, 4)`` de l'étudiant contre
+    :func:`~kalman_course.gaspari_cohn`. Sans argument, les solutions du correcteur. Renvoie un
+    :class:`~kalman_course.scenarios.labs.LabRun` : ``data`` (``distance``, ``reference_taper``,
+    ``reference_rmse``), ``reference`` et ``student`` (``rmse``, ``taper``), ``message``."""
+    from .. import practice
+    from ..filters.ensemble_analysis import etkf_update as package_update
+    from ..filters.ensemble_analysis import gaspari_cohn as package_taper
+    from .labs import LabRun
+
+    update = practice.exercise("etkf-update").solution if etkf_update is None else etkf_update
+    taper = practice.exercise("gaspari-cohn").solution if gaspari_cohn is None else gaspari_cohn
+    gen = np.random.default_rng(LAB_SEED)
+    model = twin_system("lorenz96").model
+    start = np.asarray(attractor_start())
+    truth = simulate(model, start, LAB_CYCLES, rng=gen)
+    E0 = start + gen.standard_normal((LAB_MEMBERS, 40))
+    I = np.eye(40)
+    distance = np.linspace(0.0, 16.0, 161)
+
+    def cycle(analysis):
+        E, rmse = E0.copy(), []
+        for k in range(LAB_CYCLES):
+            E = model.f(E, None)
+            E = np.asarray(analysis(E.copy(), truth.y[k].copy(), I.copy(), I.copy(), LAB_INFLATION), dtype=float)
+            if E.shape != (LAB_MEMBERS, 40):
+                raise ValueError(f"etkf_update doit renvoyer l'ensemble analysé ({LAB_MEMBERS}, 40) ; "
+                                 f"elle renvoie la forme {E.shape}")
+            rmse.append(np.sqrt(np.mean((E.mean(axis=0) - truth.x[k]) ** 2)))
+        return np.array(rmse)
+
+    reference = {"rmse": cycle(lambda *a: package_update(*a[:4], inflation=a[4])),
+                 "taper": package_taper(distance, LAB_RADIUS)}
+    outcome = practice.attempt(lambda: {"rmse": cycle(update),
+                                        "taper": np.asarray(taper(distance.copy(), LAB_RADIUS), dtype=float)})
+    data = {"distance": distance, "reference_taper": reference["taper"], "reference_rmse": reference["rmse"]}
+    return LabRun(data, reference, outcome.value, outcome.message)
+
+
 class DapperRow(NamedTuple):
     """Une ligne du tableau publié : système, méthode et réglages (arguments de :func:`twin_experiment`),
     nom de la méthode dans DAPPER, rmse.a publié, et ``verdict`` annoncé par les chapitres (voir
@@ -294,3 +560,46 @@ def verdict(published: float, mean: float, std: float, n_seeds: int) -> str:
     if abs(mean - published) > tol:
         return "non reproduit"
     return "reproduit" if tol <= CONCLUSIVE_SHARE * published else "non concluant"
+
+
+# --------------------------------------------------------------------------- tableaux des chapitres
+
+
+def dapper_table(systems: tuple[str, ...] = SYSTEMS, methods: tuple[str, ...] = METHODS):
+    """Le tableau de DAPPER reproduit (mesure rangée par ``benchmarks/assimilation_table.py --write``, 1000
+    cycles, plusieurs graines), restreint aux ``systems`` et ``methods`` : méthode de DAPPER, système, rmse.a
+    publié, moyenne ± écart-type entre graines, verdict (:class:`~kalman_course.Table`)."""
+    from ..numbers import format_number
+    from ..tables import Table
+    from . import assimilation_table as stored
+
+    names = {"lorenz96": "Lorenz-96", "lorenz63": "Lorenz-63"}
+    rows = [(row, m, s) for row, m, s in zip(DAPPER_TABLE, stored.MEAN, stored.STD)
+            if row.system in systems and row.method in methods]
+    return Table(
+        ["méthode (DAPPER)", "système", "rmse.a publié", f"rmse.a reproduit ({stored.N_SEEDS} graines)", "verdict"],
+        [[f"`{r.dapper}`" for r, _, _ in rows], [names[r.system] for r, _, _ in rows],
+         [r.published for r, _, _ in rows],
+         [f"{format_number(m, decimals=3)} ± {format_number(s, decimals=3)}" for _, m, s in rows],
+         [r.verdict for r, _, _ in rows]],
+        [None, None, "{:.2f}", None, None],
+    )
+
+
+def cost_table():
+    """Le coût par cycle des filtres d'ensemble sur Lorenz-96 (mesure rangée par
+    ``benchmarks/assimilation_costs.py --write``) : paquet, par membre, boucle numpy, rapport."""
+    from ..tables import Table
+    from . import assimilation_costs as stored
+
+    keys = list(stored.CYCLE)
+    members = [int(k.rsplit("N = ", 1)[1]) for k in keys]
+    package = [stored.CYCLE[k][0] for k in keys]
+    loop = [stored.CYCLE[k][1] for k in keys]
+    return Table(
+        ["méthode, taille de l'état n, membres N", "paquet (µs par cycle)", "par membre (µs)",
+         "boucle numpy (µs par cycle)", "boucle / paquet"],
+        [keys, package, [p / N for p, N in zip(package, members)], loop, [b / p for b, p in zip(loop, package)]],
+        [None, "{:.0f}", "{:.1f}", "{:.0f}", "{:.1f}"],
+    )
+
