@@ -1,7 +1,7 @@
 """Capture d'écran d'une page du site construit, dans Chromium sans écran (Debian,
 /usr/bin/chromium-headless-shell).
 
-Usage : python scripts/screenshot.py _build/html/book/intro.html capture.png [--width 1280] [--full]
+Usage : python scripts/screenshot.py _build/html/book/intro.html capture.png [--width 1280] [--full] [--dark]
 Le site est servi sur 127.0.0.1 (port libre) ; toute requête non locale est bloquée et signalée.
 """
 
@@ -29,6 +29,7 @@ def main() -> int:
     parser.add_argument("--width", type=int, default=1280)
     parser.add_argument("--height", type=int, default=900)
     parser.add_argument("--full", action="store_true", help="page entière")
+    parser.add_argument("--dark", action="store_true", help="mode sombre (prefers-color-scheme: dark)")
     args = parser.parse_args()
     root = args.root.resolve()
     rel = args.page.resolve().relative_to(root).as_posix()
@@ -40,7 +41,8 @@ def main() -> int:
     blocked: list[str] = []
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path="/usr/bin/chromium-headless-shell", args=CHROMIUM_ARGS)
-        page = browser.new_page(viewport={"width": args.width, "height": args.height})
+        page = browser.new_page(viewport={"width": args.width, "height": args.height},
+                                color_scheme="dark" if args.dark else "light")
 
         def route(r):
             if r.request.url.startswith(base) or r.request.url.startswith("data:"):

@@ -693,7 +693,7 @@ def test_built_lab_page_ran_its_solutions_and_offers_the_student_notebook(built_
 
 
 def test_tutorial_four_answers_are_the_package_values():
-    """TD 4 : l'analyse de l'ETKF à deux membres et le taper de Gaspari–Cohn, recalculés par le paquet (et
+    """TD 6 : l'analyse de l'ETKF à deux membres et le taper de Gaspari–Cohn, recalculés par le paquet (et
     la racine de Cholesky de numpy, pour la question 5)."""
     text = _page("td-assimilation")
     E = np.array([[1.0, 0.0], [3.0, 2.0]])

@@ -48,8 +48,8 @@ CHAPTER_TITLES: dict[str, str] = {
     "filtrage-parallele": "Filtrer en parallèle dans le temps",
     "assimilation-ensemble": "Le filtre d'ensemble en grande dimension",
     "methodes-variationnelles": "Méthodes variationnelles",
-    "td-assimilation": "TD 4 — Assimilation de données à la main",
-    "tp-assimilation": "TP 5 — L'ETKF sur Lorenz-96",
+    "td-assimilation": "TD 6 — Assimilation de données à la main",
+    "tp-assimilation": "TP 6 — L'ETKF sur Lorenz-96",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

@@ -63,7 +63,7 @@ def lorenz96_hovmoller():
     axes[0].set_ylabel("temps (unités de temps du modèle)")
     for image, where, label in ((images[0], [axes[0]], "xᵢ vrai (sans unité)"),
                                 (images[1], [axes[1]], "erreur (sans unité)"),
-                                (images[3], list(axes[2:]), "erreur (sans unité), échelle ±2")):
+                                (images[3], list(axes[2:]), "erreur, échelle ±2 (sans unité)")):
         bar = fig.colorbar(image, ax=where, location="bottom", shrink=0.85)
         bar.set_label(label, fontsize=8)
     return fig
@@ -135,17 +135,26 @@ def var3d_lorenz63():
     window = slice(200, 260)
     exp = runs["3dvar"]
     t = 0.25 * np.arange(1, exp.x_true.shape[0] + 1)[window]
-    fig, ax = new_figure(width=8.0, height=3.8)
+    fig, (ax, bx) = new_figure(2, 1, width=8.0, height=5.6, sharex=True, gridspec_kw={"height_ratios": [1.4, 1]})
     ax.plot(t, exp.x_true[window, 0], color="black", lw=1.6, label="vérité")
     ax.plot(t, exp.y[window, 0], "+", color="tab:red", ms=6, label="observations (écart-type √2)")
     ax.plot(t, exp.x[window, 0], "o-", color="tab:blue", ms=3, lw=1.0, label="3D-Var (B = 0,1 Σ)")
     ax.plot(t, runs["oi"].x[window, 0], "s--", color="tab:green", ms=3, lw=1.0,
             label="interpolation optimale (ébauche climatologique)")
-    ax.set_xlabel("temps (unités de temps du modèle)")
     ax.set_ylabel("x₁ (sans unité)")
     ax.set_title("Lorenz-63, cycles 200 à 260 d'une expérience de 1000 cycles", fontsize=10)
-    ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="lower left", ncols=2)
+    obs = np.sqrt(np.mean((exp.y - exp.x_true) ** 2, axis=1))
+    bx.plot(t, obs[window], "+:", color="tab:red", ms=6, lw=0.8, label="observations")
+    bx.plot(t, exp.rmse[window], "o-", color="tab:blue", ms=3, lw=1.0, label="3D-Var")
+    bx.plot(t, runs["oi"].rmse[window], "s--", color="tab:green", ms=3, lw=1.0, label="interpolation optimale")
+    bx.set_xlabel("temps (unités de temps du modèle)")
+    bx.set_ylabel("erreur (sans unité)")
+    bx.set_title("Erreur de chaque cycle (moyenne quadratique sur les trois variables)", fontsize=10)
+    bx.set_ylim(0.0, None)
+    bx.legend(fontsize=7, loc="upper right", ncols=3)
+    for a in (ax, bx):
+        a.grid(alpha=0.3)
     return fig
 
 
@@ -154,7 +163,7 @@ def _note(fig, message: str | None) -> None:
         fig.suptitle(f"Votre fonction n'a pas pu servir : {message}", fontsize=9, color="tab:red")
 
 
-@register("tp-etkf", chapter="tp-assimilation", title="TP 5 : votre ETKF et votre taper contre ceux du paquet (Lorenz-96)")
+@register("tp-etkf", chapter="tp-assimilation", title="TP 6 : votre ETKF et votre taper contre ceux du paquet (Lorenz-96)")
 def etkf_lab_figure(etkf_update=None, gaspari_cohn=None):
     run = assim.etkf_lab(etkf_update, gaspari_cohn)
     fig, (ax, bx) = new_figure(1, 2, width=9.0, height=3.6, gridspec_kw={"width_ratios": [1.6, 1]})
@@ -180,7 +189,7 @@ def etkf_lab_figure(etkf_update=None, gaspari_cohn=None):
 
 
 @register("td-etkf-deux-membres", chapter="td-assimilation",
-          title="TD 4 : une analyse de l'ETKF à deux membres, et le taper de Gaspari–Cohn de demi-support 2")
+          title="TD 6 : une analyse de l'ETKF à deux membres, et le taper de Gaspari–Cohn de demi-support 2")
 def td_two_members():
     from ..filters.ensemble_analysis import etkf_update, gaspari_cohn
 

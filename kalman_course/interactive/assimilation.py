@@ -94,7 +94,7 @@ def inflation_spec() -> SliderSpec:
         axes=inflation_axes(),
         run=inflation_run,
         time=_CYCLES,
-        fixed={"lam": lam, "div_lo": np.ones_like(lam), "div_hi": np.full_like(lam, 10.0)},
+        fixed={"lam": lam, "div_lo": np.ones_like(lam), "div_hi": np.full_like(lam, 20.0)},
         panels=(
             _rmse_panel((Glyph("rmse", "line", "royalblue", "EnKF stochastique", width=1.5),)),
             Panel(
@@ -103,7 +103,7 @@ def inflation_spec() -> SliderSpec:
                 (Glyph("div_lo", "band", "crimson", "divergence : pire que les observations", x="lam", upper="div_hi",
                        alpha=0.6),) + map_glyphs
                 + (Glyph("here_y", "scatter", "black", "réglage affiché", x="here_x", marker="star", size=16),),
-                y_log=True, y_range=(0.1, 10.0), x_label="inflation λ (sans unité)", x_range=(0.99, 1.21),
+                y_log=True, y_range=(0.05, 20.0), x_label="inflation λ (sans unité)", x_range=(0.99, 1.21),
                 height=280,
             ),
         ),
@@ -227,7 +227,7 @@ def density_spec() -> SliderSpec:
                 "rmse.a en fonction du nombre de variables observées, le réglage affiché en étoile",
                 "rmse.a (sans unité)",
                 curves + marks,
-                y_log=True, y_range=(0.1, 10.0), x_label="variables observées (nombre)", x_range=(0.0, 42.0),
+                y_log=True, y_range=(0.05, 20.0), x_label="variables observées (nombre)", x_range=(0.0, 42.0),
                 height=260,
             ),
         ),
