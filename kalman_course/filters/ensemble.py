@@ -259,7 +259,8 @@ def ensemble_kalman_filter(
     inflation : :math:`\lambda \ge 1`, facteur des anomalies analysées (1 : aucune inflation).
     localization : rayon de localisation :math:`> 0` (``numpy.inf`` permis) : ``"etkf"`` devient le LETKF
         (:func:`~kalman_course.filters.ensemble_analysis.letkf_update`) ; ``numpy.inf`` redonne, avec le même
-        ``rng``, le résultat de ``localization=None`` (aux arrondis près).
+        ``rng``, le résultat de ``localization=None`` (au bit près : tous les poids valent 1, les analyses
+        locales sont l'analyse globale).
     distances : (m, n), exigé avec ``localization`` — distance de l'observation :math:`i` à la composante
         :math:`j` de l'état.
 

@@ -255,8 +255,12 @@ def letkf_analysis(x_bar, A, Y, d, R, rho, inflation: float = 1.0, W=None) -> np
     :math:`e_j = \sqrt{\rho_{\mathcal L_j j}} \circ \tilde d_{\mathcal L_j}`, les :math:`n` analyses sont faites
     en lot, par un seul ``eigh`` sur une pile de :math:`n` matrices : :math:`Z_jZ_j^T` (N, N) si
     :math:`N \le k`, sinon :math:`Z_j^TZ_j` (k, k) (mêmes valeurs propres non nulles, mêmes formules que
-    :func:`etkf_analysis`)."""
+    :func:`etkf_analysis`). Quand tous les poids valent 1 (rayon infini), les :math:`n` analyses locales
+    sont exactement l'analyse globale : :func:`etkf_analysis` la calcule une fois (même résultat, au bit près,
+    que l'ETKF)."""
     W = symmetric_inverse_root(R) if W is None else W
+    if np.all(rho == 1.0):  # tous les poids valent 1 (rayon infini) : les n analyses locales sont l'analyse globale
+        return etkf_analysis(x_bar, A, Y, d, R, inflation, W=W)
     Yt, dt = Y.dot(W), W.dot(d)                         # (N, m), (m,)
     N1, n = Yt.shape[0] - 1, A.shape[1]
     reach = rho > 0.0
@@ -366,7 +370,7 @@ def letkf_update(E: Any, y: Any, C: Any, R: Any, distances: Any, *, radius: Any,
     Avec :math:`\tilde Y = YR^{-1/2}` et :math:`\tilde d = R^{-1/2}d` (racine symétrique), la colonne
     :math:`j` de :math:`E^a` est la colonne :math:`j` de l'ETKF (:func:`etkf_update`) calculé avec
     :math:`\tilde Y\operatorname{diag}(\sqrt{\rho_{\cdot j}})`, :math:`\operatorname{diag}(\sqrt{\rho_{\cdot j}})\tilde d`
-    et :math:`R = I` ; aucune autre coupure. ``radius=numpy.inf`` redonne l'ETKF (aux arrondis près).
+    et :math:`R = I` ; aucune autre coupure. ``radius=numpy.inf`` redonne l'ETKF (au bit près).
 
     Paramètres
     ----------
