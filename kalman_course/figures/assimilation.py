@@ -114,9 +114,9 @@ def var3d_cost():
     J = Jb + Jo
     J_min = J.min()
     ax.contour(X, Y, J, levels=[J_min + v for v in levels], colors="tab:blue", linewidths=1.4)
-    ax.plot(*case.x_b, "o", color="tab:orange", ms=8, label="ébauche x_b (contours : J_b)")
-    ax.plot([], [], ":", color="tab:red", label="observation de x₁ (contours : J_o)")
-    ax.plot([], [], "-", color="tab:blue", label="J = J_b + J_o")
+    ax.plot(*case.x_b, "o", color="tab:orange", ms=8, label=r"ébauche $x_b$ (contours de $J_b$)")
+    ax.plot([], [], ":", color="tab:red", label=r"observation de x₁ (contours de $J_o$)")
+    ax.plot([], [], "-", color="tab:blue", label=r"$J = J_b + J_o$")
     ax.plot(*case.x_a, "*", color="tab:blue", ms=14, label="minimum de J = correction de Kalman")
     ax.plot(*case.x_numeric, "x", color="black", ms=9, label="minimum trouvé par scipy.optimize")
     ax.set_xlabel("x₁, observée (sans unité)")

@@ -578,7 +578,7 @@ def dapper_table(systems: tuple[str, ...] = SYSTEMS, methods: tuple[str, ...] = 
             if row.system in systems and row.method in methods]
     return Table(
         ["méthode (DAPPER)", "système", "rmse.a publié", f"rmse.a reproduit ({stored.N_SEEDS} graines)", "verdict"],
-        [[f"`{r.dapper}`" for r, _, _ in rows], [names[r.system] for r, _, _ in rows],
+        [[r.dapper for r, _, _ in rows], [names[r.system] for r, _, _ in rows],
          [r.published for r, _, _ in rows],
          [f"{format_number(m, decimals=3)} ± {format_number(s, decimals=3)}" for _, m, s in rows],
          [r.verdict for r, _, _ in rows]],
