@@ -577,13 +577,34 @@ def dapper_table(systems: tuple[str, ...] = SYSTEMS, methods: tuple[str, ...] = 
     rows = [(row, m, s) for row, m, s in zip(DAPPER_TABLE, stored.MEAN, stored.STD)
             if row.system in systems and row.method in methods]
     return Table(
-        ["méthode (DAPPER)", "système", "rmse.a publié", f"rmse.a reproduit ({stored.N_SEEDS} graines)", "verdict"],
-        [[r.dapper for r, _, _ in rows], [names[r.system] for r, _, _ in rows],
+        ["méthode (DAPPER)", "réglages", "système", "rmse.a publié", f"rmse.a reproduit ({stored.N_SEEDS} graines)",
+         "verdict"],
+        [[r.dapper.split("(")[0] + ("('" + r.dapper.split("'")[1] + "')" if "'" in r.dapper else "")
+          for r, _, _ in rows],
+         [_settings_text(r) for r, _, _ in rows], [names[r.system] for r, _, _ in rows],
          [r.published for r, _, _ in rows],
          [f"{format_number(m, decimals=3)} ± {format_number(s, decimals=3)}" for _, m, s in rows],
          [r.verdict for r, _, _ in rows]],
-        [None, None, "{:.2f}", None, None],
+        [None, None, None, "{:.2f}", None, None],
     )
+
+
+def _settings_text(row: DapperRow) -> str:
+    """Les réglages d'une ligne du tableau, écrits en français : « N = 40, λ = 1,06 », « B = 0,1 Σ »…"""
+    from ..numbers import format_number
+
+    parts = []
+    if "n_members" in row.settings:
+        parts.append(f"N = {row.settings['n_members']}")
+    if "inflation" in row.settings:
+        parts.append(f"λ = {format_number(row.settings['inflation'], significant=4, trim=True)}")
+    if "localization" in row.settings:
+        parts.append(f"rayon {format_number(row.settings['localization'], significant=3, trim=True)}")
+    if "background_scale" in row.settings:
+        parts.append(f"B = {format_number(row.settings['background_scale'], significant=3, trim=True)} Σ")
+    if "rot=True" in row.dapper:
+        parts.append("rotation aléatoire (DAPPER seul)")
+    return ", ".join(parts) or "B = Σ, ébauche climatologique"
 
 
 def cost_table():
