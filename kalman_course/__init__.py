@@ -147,6 +147,10 @@ from .filters.invariant import (
     se2_standard_ekf_runs,
 )
 from .geometry.lie import se2_adjoint, se2_exp, se2_left_jacobian, se2_log, se2_right_jacobian
+# assimilation de données : Lorenz-63/96, ETKF, DEnKF, LETKF, 3D-Var, interpolation optimale (issue 33)
+from .core.lorenz import lorenz63, lorenz96
+from .filters.ensemble_analysis import denkf_update, etkf_update, gaspari_cohn, letkf_update
+from .filters.variational import optimal_interpolation, three_dimensional_var, var3d_update
 
 __all__ = [
     # modèles, résultats, erreurs
@@ -316,6 +320,16 @@ __all__ = [
     "se2_standard_ekf",
     "se2_invariant_ekf_runs",
     "se2_standard_ekf_runs",
+    # assimilation de données (issue 33)
+    "lorenz96",
+    "lorenz63",
+    "etkf_update",
+    "denkf_update",
+    "gaspari_cohn",
+    "letkf_update",
+    "var3d_update",
+    "three_dimensional_var",
+    "optimal_interpolation",
     # sous-modules
     "errata",
     "geometry",

@@ -502,6 +502,9 @@ FRENCH_REFERENCES = {
     "filtre-particulaire": ("leglandcours", "chopin2020", "cappe2005"),
     "enkf": ("legland2011", "bocquet2014"),
     "vraisemblance": ("cappe2005",),
+    # assimilation de données (issue 33)
+    "assimilation-ensemble": ("bocquet2014", "asch2016"),
+    "methodes-variationnelles": ("asch2016", "adao"),
 }
 
 

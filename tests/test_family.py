@@ -355,6 +355,13 @@ STOCHASTIC = [
         _nonlinear(m), y, x0, P0, u, n_particles=size, rng=rng)),
     Member("EnKF", lambda m, y, x0, P0, u=None, size=4000, rng=0: kc.ensemble_kalman_filter(
         _nonlinear(m), y, x0, P0, u, n_members=size, rng=rng)),
+    # assimilation de données (issue 33) : l'ETKF et le LETKF de rayon infini tendent aussi vers le KF (le
+    # DEnKF non : sa covariance analysée garde le terme ¼ KHPHᵀKᵀ — tests/test_assimilation.py)
+    Member("ETKF", lambda m, y, x0, P0, u=None, size=4000, rng=0: kc.ensemble_kalman_filter(
+        _nonlinear(m), y, x0, P0, u, n_members=size, rng=rng, method="etkf")),
+    Member("LETKF (rayon infini)", lambda m, y, x0, P0, u=None, size=4000, rng=0: kc.ensemble_kalman_filter(
+        _nonlinear(m), y, x0, P0, u, n_members=size, rng=rng, method="etkf", localization=np.inf,
+        distances=np.zeros((m.n_obs, m.n_state)))),
 ]
 STOCHASTIC_IDS = [f.name for f in STOCHASTIC]
 

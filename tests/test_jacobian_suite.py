@@ -229,6 +229,14 @@ def test_se2_prediction_steps_use_these_jacobians(kind):
     np.testing.assert_allclose(Tb[0], T, rtol=1e-12, atol=1e-12)
 
 
+# assimilation de données (issue 33) : h(x) = x de Lorenz-63 et Lorenz-96, jacobienne I
+_l63, _l96 = kc.lorenz63(), kc.lorenz96(8)
+CASES += [
+    _vector_case("Lorenz-63 : H = I", _l63.observe, _l63.observation_jacobian, [np.array([1.5, -1.5, 25.0])]),
+    _vector_case("Lorenz-96 : H = I", _l96.observe, _l96.observation_jacobian, [np.linspace(-3.0, 8.0, 8)]),
+]
+
+
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
 def test_analytic_jacobian_matches_perturbation(case):
     for point in case.points:

@@ -51,7 +51,11 @@ CHAPTER_TITLES: dict[str, str] = {
     "quel-filtre": "Quel filtre choisir ?",
     "filtrage-parallele": "Filtrer en parallèle dans le temps",
     "filtrage-invariant": "Filtrage invariant sur les groupes de Lie",
-    "td-filtrage-invariant": "TD 6 — L'EKF invariant à la main",
+    "td-filtrage-invariant": "TD 7 — L'EKF invariant à la main",
+    "assimilation-ensemble": "Le filtre d'ensemble en grande dimension",
+    "methodes-variationnelles": "Méthodes variationnelles",
+    "td-assimilation": "TD 6 — Assimilation de données à la main",
+    "tp-assimilation": "TP 6 — L'ETKF sur Lorenz-96",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).
