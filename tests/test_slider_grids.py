@@ -83,9 +83,10 @@ def test_every_chapter_of_the_book_has_a_registered_slider_figure():
     toc = yaml.safe_load((ROOT / "_toc.yml").read_text())
     pages = [toc["root"]] + [c["file"] for part in toc["parts"] for c in part["chapters"]]
     # annexes sans figure ; TD (calcul à la main) et TP (le code de l'étudiant et le verdict du correcteur)
-    # n'ont pas de curseurs : voir tests/test_chapter_pedagogy.py
+    # n'ont pas de curseurs, ni le sujet d'examen (une page d'exercices, comme un TD) : voir
+    # tests/test_chapter_pedagogy.py
     chapters = {p.split("/")[-1] for p in pages} - {"references", "errata", "glossaire"}
-    chapters = {c for c in chapters if not c.startswith(("td-", "tp-"))}
+    chapters = {c for c in chapters if not c.startswith(("td-", "tp-")) and c != "sujet-examen"}
     have = {ki.SLIDER_FIGURES[n][0] for n in ki.slider_names()}
     assert chapters <= have, f"chapitres sans figure à curseurs : {sorted(chapters - have)}"
 

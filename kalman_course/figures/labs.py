@@ -135,7 +135,7 @@ def nile_lab_figure(rts_step=None, m_step=None):
 
 
 @register("tp-samu", chapter="tp-helicoptere-samu",
-          title="TP 5 : votre porte et votre IMM contre ceux du paquet sur le vol de l'hélicoptère SAMU 31")
+          title="TP 5 : votre fenêtre de validation et votre IMM contre ceux du paquet sur le vol de l'hélicoptère SAMU 31")
 def samu_lab_figure(cv_model=None, nis_gate=None, van_loan=None, imm_mix=None, mode_probabilities=None,
                     imm_merge=None):
     from ..numbers import format_number
@@ -147,7 +147,7 @@ def samu_lab_figure(cv_model=None, nis_gate=None, van_loan=None, imm_mix=None, m
     km = 1e-3
     ax.plot(y[:, 0] * km, y[:, 1] * km, "+", color="0.55", ms=4, label="positions mesurées")
     ax.plot(y_bad[bad, 0] * km, y_bad[bad, 1] * km, "x", color="crimson", ms=8, mew=2, label="positions aberrantes")
-    ax.plot(ref["gate_x"][:, 0] * km, ref["gate_x"][:, 1] * km, color=PACKAGE, lw=2.0, label="paquet : porte")
+    ax.plot(ref["gate_x"][:, 0] * km, ref["gate_x"][:, 1] * km, color=PACKAGE, lw=2.0, label="paquet : fenêtre de validation")
     rejected = ref["rejected"]
     ax.plot(y_bad[rejected, 0] * km, y_bad[rejected, 1] * km, "o", mfc="none", color=PACKAGE, ms=9,
             label="rejetées par le paquet")
@@ -155,12 +155,12 @@ def samu_lab_figure(cv_model=None, nis_gate=None, van_loan=None, imm_mix=None, m
         ax.plot(you["gate_x"][:, 0] * km, you["gate_x"][:, 1] * km, "--", color=YOURS, lw=1.5, label="votre filtre")
         mine = you["rejected"]
         ax.plot(y_bad[mine, 0] * km, y_bad[mine, 1] * km, "s", mfc="none", color=YOURS, ms=12,
-                label="rejetées par votre porte")
+                label="rejetées par votre fenêtre")
     ax.set_xlabel("est (km)")
     ax.set_ylabel("nord (km)")
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_title(f"Porte p = {format_number(LAB_SAMU_GATE, decimals=3)} sur six positions corrompues",
-                 fontsize=9)
+    ax.set_title(f"Fenêtre de validation p = {format_number(LAB_SAMU_GATE, decimals=3)} sur six positions "
+                 "corrompues", fontsize=9)
     ax.legend(loc="lower left", fontsize=7)
     turn = az.twinx()
     turn.fill_between(run.data["rate_t"], np.abs(run.data["rate"]), color="0.85", lw=0, zorder=0)

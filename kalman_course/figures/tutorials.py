@@ -115,7 +115,7 @@ def three_steps_figure():
 
 
 @register("td-porte-imm", chapter="td-cibles-reelles",
-          title="TD 4 : le quantile de la porte pour m = 2, et un pas d'IMM scalaire")
+          title="TD 4 : le seuil de la fenêtre de validation pour m = 2, et un pas d'IMM scalaire")
 def gate_and_imm_figure():
     from ..scenarios.tutorials import GATE_EXAMPLE, IMM_EXAMPLE, gate_example, imm_step
 
@@ -133,7 +133,7 @@ def gate_and_imm_figure():
                     ha="right", fontsize=8)
     ax.set_xlabel(r"NIS $\epsilon$ (sans unité)")
     ax.set_ylabel(r"probabilité $P(\epsilon_k \leq \epsilon)$ (sans unité)")
-    ax.set_title("La porte pour m = 2 : quantile −2 ln(1 − p)", fontsize=10)
+    ax.set_title("Fenêtre de validation pour m = 2 : seuil −2 ln(1 − p)", fontsize=10)
     ax.legend(loc="center right", fontsize=8)
     ax.grid(alpha=0.3)
     x = np.linspace(0.0, 6.0, 500)

@@ -343,7 +343,7 @@ def _gate_cases() -> list[Case]:
         _gate_case("m = 1, p = 0,95, ε juste sous le seuil", np.array([3.8]), np.array([[3.8**2 / 3.8]]), 0.95),
         _gate_case("m = 3, S pleine, p = 0,99", np.array([2.0, -3.5, 1.0]), S3, 0.99),
         _gate_case("m = 4 (positions et vitesses), p = 0,9", np.array([1.2, -0.8, 2.1, 0.5]), S4, 0.9),
-        _gate_case("m = 2, p = 0,5 (porte médiane)", np.array([1.0, 1.0]), np.eye(2), 0.5),
+        _gate_case("m = 2, p = 0,5 (fenêtre de validation médiane)", np.array([1.0, 1.0]), np.eye(2), 0.5),
     ]
 
 
@@ -394,7 +394,7 @@ def _gate_inverted(nu, S, p):
 
 NIS_GATE = Exercise(
     id="nis-gate",
-    title="Porte sur la NIS : accepter ou rejeter une mesure",
+    title="Fenêtre de validation sur la NIS : accepter ou rejeter une mesure",
     chapter="capteurs-temps-irregulier",
     signature="nis_gate(nu, S, p) -> (eps, threshold, accept)",
     parameters=("nu", "S", "p"),
@@ -410,8 +410,8 @@ NIS_GATE = Exercise(
                 _gate_dof(1), detect=_detect_wrong_dof, culprit=(r"ppf\(|chi2|isf\(",),
                 refute=(r"len\(\s*nu|nu\.(shape|size)|\bm\b",), output=1),
         Mistake("one-minus-p", "quantile 1 − p au lieu de p",
-                "La porte garde une mesure conforme au modèle avec la probabilité p : le seuil est le quantile p, "
-                "`chi2.ppf(p, m)` (ou `chi2.isf(1 - p, m)`). Le quantile 1 − p rejette presque tout.",
+                "La fenêtre de validation garde une mesure conforme au modèle avec la probabilité p : le seuil est "
+                "le quantile p, `chi2.ppf(p, m)` (ou `chi2.isf(1 - p, m)`). Le quantile 1 − p rejette presque tout.",
                 _gate_one_minus_p, outputs=(1,), output=1, culprit=(r"ppf\(|isf\(",)),
         Mistake("sqrt", "distance de Mahalanobis √ε comparée au quantile du χ²",
                 "Le quantile du χ² se compare à ε = νᵀ S⁻¹ ν lui-même, pas à sa racine (la distance de Mahalanobis, "
@@ -421,8 +421,8 @@ NIS_GATE = Exercise(
                 "La NIS normalise l'innovation par sa covariance : ε = νᵀ S⁻¹ ν (`nu @ np.linalg.solve(S, nu)`).",
                 _gate_s_not_inverted, outputs=(0,), output=0),
         Mistake("inverted-decision", "décision inversée",
-                "On accepte la mesure quand elle est **dans** la porte, ε ≤ seuil ; on la rejette quand ε dépasse "
-                "le seuil.",
+                "On accepte la mesure quand elle est **dans** la fenêtre de validation, ε ≤ seuil ; on la rejette "
+                "quand ε dépasse le seuil.",
                 _gate_inverted, outputs=(2,), output=2),
     ),
 )

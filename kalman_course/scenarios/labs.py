@@ -355,7 +355,8 @@ def samu_lab(cv_model: Callable | None = None, nis_gate: Callable | None = None,
     gate_values, gate_message = _run(gate_run)
     imm_values, imm_message = _run(imm_run)
     student = {**(gate_values or {"gate_x": None, "rejected": None}), **(imm_values or {"imm_x": None, "mu": None})}
-    messages = [f"porte : {gate_message}" if gate_message else "", f"IMM : {imm_message}" if imm_message else ""]
+    messages = [f"fenêtre de validation : {gate_message}" if gate_message else "",
+                f"IMM : {imm_message}" if imm_message else ""]
     message = " ; ".join(m for m in messages if m) or None
     outliers = np.flatnonzero(track.position_rows)[list(OUTLIER_ROWS)]
     from .manoeuvre import measured_turn_rate
