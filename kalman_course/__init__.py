@@ -137,6 +137,21 @@ from .filters.gauss_hermite import GaussHermiteRule, gauss_hermite_kalman_filter
 from .filters.posterior_linearization import iterated_posterior_linearization_filter
 # filtrer et lisser en parallèle dans le temps (issue 22)
 from .filters.parallel import parallel_kalman_filter, parallel_rts_smoother
+# plusieurs cibles dans le fouillis : porte, association, gestion des pistes, GOSPA (issue 37)
+from .multitarget import (
+    GOSPA,
+    Gate,
+    MultiTargetResult,
+    PDAUpdate,
+    gnn_assign,
+    gospa,
+    jpda_probabilities,
+    multi_target_tracker,
+    nn_assign,
+    ospa,
+    pda_update,
+    validation_gate,
+)
 
 __all__ = [
     # modèles, résultats, erreurs
@@ -294,6 +309,19 @@ __all__ = [
     "iterated_posterior_linearization_filter",
     "parallel_kalman_filter",
     "parallel_rts_smoother",
+    # plusieurs cibles dans le fouillis (issue 37)
+    "validation_gate",
+    "Gate",
+    "nn_assign",
+    "gnn_assign",
+    "pda_update",
+    "PDAUpdate",
+    "jpda_probabilities",
+    "gospa",
+    "GOSPA",
+    "ospa",
+    "multi_target_tracker",
+    "MultiTargetResult",
     # sous-modules
     "errata",
     "geometry",

@@ -12,9 +12,10 @@ from .validation import KalmanInputError
 __all__ = ["FilterResult", "FilterRuns", "FilterHistory", "freeze", "freeze_fields"]
 
 
-def freeze(arr: np.ndarray) -> np.ndarray:
-    """Copie en lecture seule (les résultats sont immuables)."""
-    out = np.array(arr, dtype=float, copy=True)
+def freeze(arr: np.ndarray, dtype: type = float) -> np.ndarray:
+    """Copie en lecture seule (les résultats sont immuables), de type ``dtype`` (``float`` par défaut ;
+    ``bool`` ou ``np.intp`` pour des masques et des indices)."""
+    out = np.array(arr, dtype=dtype, copy=True)
     out.setflags(write=False)
     return out
 
