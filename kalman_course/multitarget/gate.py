@@ -65,13 +65,17 @@ class Gate(NamedTuple):
 
 
 class Innovations(NamedTuple):
-    r"""Les grandeurs d'une porte, pour les calculs qui suivent (PDA, JPDA, affectation) : ``nu`` (T, N, m)
-    innovations ; ``S`` (T, m, m) ; ``L`` (T, m, m) facteur de Cholesky inférieur de ``S`` ; ``nis``
-    (T, N) ; ``log_det_S`` (T,) :math:`\log\det S_t`."""
+    r"""Les grandeurs d'une porte, pour les calculs qui suivent (PDA, JPDA, affectation), avec
+    :math:`S_t = L_tL_t^T` (Cholesky) : ``nu`` (T, N, m) innovations :math:`\nu_{tj}` ; ``S``, ``L`` (T, m, m) ;
+    ``white`` (T, N, m) innovations blanchies :math:`w_{tj} = L_t^{-1}\nu_{tj}` ; ``G`` (T, m, n)
+    :math:`G_t = L_t^{-1}CP_t` (d'où :math:`K_t = G_t^TL_t^{-1}` et :math:`K_tS_tK_t^T = G_t^TG_t`) ; ``nis``
+    (T, N) :math:`d^2_{tj} = \lVert w_{tj}\rVert^2` ; ``log_det_S`` (T,)."""
 
     nu: np.ndarray
     S: np.ndarray
     L: np.ndarray
+    white: np.ndarray
+    G: np.ndarray
     nis: np.ndarray
     log_det_S: np.ndarray
 
@@ -148,23 +152,25 @@ def gate_volume(gamma: float, log_det_S: np.ndarray, m: int) -> np.ndarray:
 
 
 def innovations(C: np.ndarray, R: np.ndarray, x: np.ndarray, P: np.ndarray, z: np.ndarray) -> Innovations:
-    r"""Innovations :math:`\nu_{tj} = z_j - C\hat x_t` (T, N, m), :math:`S_t = CP_tC^T + R`, leurs facteurs de
-    Cholesky et les NIS, sans vérification des entrées (le noyau des fonctions publiques et du pisteur)."""
-    nu = z[None, :, :] - (x @ C.T)[:, None, :]
-    S = C @ P @ C.T + R
+    r"""Innovations :math:`\nu_{tj} = z_j - C\hat x_t` (T, N, m), :math:`S_t = CP_tC^T + R = L_tL_t^T`, et, par
+    **une** résolution triangulaire empilée, les innovations blanchies :math:`L_t^{-1}\nu_{tj}` et
+    :math:`G_t = L_t^{-1}CP_t` ; sans vérification des entrées (le noyau des fonctions publiques et du
+    pisteur). :math:`S` n'est jamais inversée."""
+    N = z.shape[0]
+    CP = C @ P                                                                # (T, m, n)
+    nu = z[None, :, :] - (x @ C.T)[:, None, :]                                # (T, N, m)
+    S = CP @ C.T + R
     S = 0.5 * (S + np.swapaxes(S, -1, -2))
     try:
         L = np.linalg.cholesky(S)
     except np.linalg.LinAlgError:
         raise KalmanInputError("La covariance d'innovation « S = C P_pred Cᵀ + R » d'une piste n'est pas définie "
                                "positive : vérifiez P_pred et R.") from None
-    if z.shape[0]:
-        w = np.linalg.solve(L, np.swapaxes(nu, 1, 2))  # (T, m, N) : L⁻¹ν
-        nis = np.einsum("tmj,tmj->tj", w, w)
-    else:
-        nis = np.zeros((x.shape[0], 0))
+    solved = np.linalg.solve(L, np.concatenate([np.swapaxes(nu, 1, 2), CP], axis=2))  # L⁻¹ [νᵀ | C P]
+    white = np.swapaxes(solved[:, :, :N], 1, 2)                               # (T, N, m)
+    nis = np.sum(white * white, axis=2)
     log_det_S = 2.0 * np.log(np.diagonal(L, axis1=1, axis2=2)).sum(axis=1)
-    return Innovations(nu, S, L, nis, log_det_S)
+    return Innovations(nu, S, L, white, solved[:, :, N:], nis, log_det_S)
 
 
 def validation_gate(model: Any, x_pred: Any, P_pred: Any, detections: Any, *, gate_probability: Any) -> Gate:

@@ -48,17 +48,21 @@ MAX_EVENTS = 20_000_000
 def clusters(inside: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     r"""Les grappes du graphe pistes–détections de la porte ``inside`` (T, N) : une liste de couples
     ``(pistes, détections)`` (indices croissants) ; chaque piste d'une grappe a au moins une détection dans
-    sa porte (les pistes sans détection n'y figurent pas)."""
-    T, N = inside.shape
-    t_idx, d_idx = np.nonzero(inside)
-    if t_idx.size == 0:
+    sa porte (les pistes sans détection n'y figurent pas). Deux pistes sont voisines si elles partagent une
+    détection (:math:`M = \mathbb 1[\text{inside}\,\text{inside}^T > 0]`) ; les grappes sont les composantes
+    connexes de ce graphe (``scipy.sparse.csgraph``)."""
+    tracks = np.flatnonzero(inside.any(axis=1))
+    if tracks.size == 0:
         return []
-    graph = scipy.sparse.coo_matrix((np.ones(t_idx.size), (t_idx, T + d_idx)), shape=(T + N, T + N))
-    _, label = scipy.sparse.csgraph.connected_components(graph, directed=False)
+    sub = inside[tracks].astype(float)
+    shared = sub @ sub.T > 0.0
+    if np.count_nonzero(shared) == tracks.size:  # aucune détection partagée : une grappe par piste
+        return [(tracks[i:i + 1], np.flatnonzero(inside[tracks[i]])) for i in range(tracks.size)]
+    labels = scipy.sparse.csgraph.connected_components(scipy.sparse.csr_matrix(shared), directed=False)[1]
     out = []
-    for lab in np.unique(label[t_idx]):
-        members = np.flatnonzero(label == lab)
-        out.append((members[members < T], members[members >= T] - T))
+    for lab in range(labels.max() + 1):
+        members = tracks[labels == lab]
+        out.append((members, np.flatnonzero(inside[members].any(axis=0))))
     return out
 
 
@@ -72,6 +76,8 @@ def _cluster_marginals(w: np.ndarray) -> np.ndarray:
     (produit des poids). Chaque piste prolonge chaque ligne par chacune de ses options ; une option dont
     le bit est déjà levé est retirée."""
     T_c, n_options = w.shape
+    if T_c == 1:  # une piste seule : ses poids PDA normalisés
+        return w / w.sum()
     words = max(1, -(-(n_options - 1) // 64))
     choice = np.zeros((1, 0), dtype=np.int32)
     used = np.zeros((1, words), dtype=np.uint64)

@@ -75,21 +75,25 @@ def association_weights(inn: Innovations, m: int, p_detect: float, density: floa
     return w, inside
 
 
-def combine(x: np.ndarray, P: np.ndarray, inn: Innovations, beta: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def combine(x: np.ndarray, P: np.ndarray, inn: Innovations, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     r"""La correction PDA de ``T`` pistes, chacune avec ses probabilités ``beta`` (T, N + 1) :
-    :math:`\hat x = \hat x^- + K\bar\nu`, :math:`P = \beta_0P^- + (1-\beta_0)(P^- - KSK^T) + K(\sum_j\beta_j
-    \nu_j\nu_j^T - \bar\nu\bar\nu^T)K^T`, :math:`K = P^-C^TS^{-1}` par résolution de Cholesky (jamais
-    d'inverse). ``x`` (T, n), ``P`` (T, n, n) ; renvoie ``(x, P)`` de mêmes formes."""
-    PCt = P @ C.T                                                              # (T, n, m)
-    # K = P Cᵀ S⁻¹ = P Cᵀ L⁻ᵀ L⁻¹ : deux résolutions triangulaires empilées
-    Kt = np.linalg.solve(np.swapaxes(inn.L, 1, 2), np.linalg.solve(inn.L, np.swapaxes(PCt, 1, 2)))
-    K = np.swapaxes(Kt, 1, 2)                                                  # (T, n, m)
+
+    .. math::
+
+        \hat x = \hat x^- + K\bar\nu,\qquad
+        P = \beta_0P^- + (1-\beta_0)(P^- - KSK^T) + K\Big(\sum_j\beta_j\nu_j\nu_j^T - \bar\nu\bar\nu^T\Big)K^T,
+
+    calculée avec les innovations blanchies :math:`w_j = L^{-1}\nu_j` et :math:`G = L^{-1}CP^-`
+    (:class:`~.gate.Innovations`) : :math:`K\bar\nu = G^T\bar w`, :math:`KSK^T = G^TG` et
+    :math:`K(\cdot)K^T = G^T(\sum_j\beta_jw_jw_j^T - \bar w\bar w^T)G` — aucune autre résolution.
+    ``x`` (T, n), ``P`` (T, n, n) ; renvoie ``(x, P)`` de mêmes formes."""
     b0, bj = beta[:, 0], beta[:, 1:]
-    nu_bar = np.einsum("tj,tjm->tm", bj, inn.nu)                               # (T, m)
-    spread = np.einsum("tj,tjm,tjk->tmk", bj, inn.nu, inn.nu) - nu_bar[:, :, None] * nu_bar[:, None, :]
-    x_new = x + np.einsum("tnm,tm->tn", K, nu_bar)
-    P_upd = P - K @ np.swapaxes(PCt, 1, 2)                                     # P⁻ − K S Kᵀ = P⁻ − K C P⁻
-    P_new = b0[:, None, None] * P + (1.0 - b0)[:, None, None] * P_upd + K @ spread @ np.swapaxes(K, 1, 2)
+    W = inn.white                                                              # (T, N, m)
+    w_bar = (bj[:, None, :] @ W)[:, 0, :]                                      # (T, m)
+    spread = (np.swapaxes(W, 1, 2) * bj[:, None, :]) @ W - w_bar[:, :, None] * w_bar[:, None, :]
+    Gt = np.swapaxes(inn.G, 1, 2)                                              # (T, n, m)
+    x_new = x + (Gt @ w_bar[:, :, None])[:, :, 0]
+    P_new = P - (1.0 - b0)[:, None, None] * (Gt @ inn.G) + Gt @ spread @ inn.G
     return x_new, symmetrize(P_new)
 
 
@@ -128,5 +132,5 @@ def pda_update(model: Any, x_pred: Any, P_pred: Any, detections: Any, *, detecti
     inn = innovations(model.C, model.R, x, P, z)
     w, inside = association_weights(inn, m, p_detect, density, gate_threshold(p_gate, m), p_gate)
     beta = w / w.sum(axis=1, keepdims=True)
-    x_new, P_new = combine(x, P, inn, beta, model.C)
+    x_new, P_new = combine(x, P, inn, beta)
     return PDAUpdate(freeze(x_new[0]), freeze(P_new[0]), freeze(beta[0]), freeze(inside[0], bool))

@@ -166,7 +166,7 @@ def multi_target_tracker(model: Any, scans: Any, *, detection_probability: Any, 
                 beta = _one_hot(assigned, N)
                 hit = assigned >= 0
                 used[assigned[hit]] = True
-            xc, Pc = combine(xc, Pc, inn, beta, C)
+            xc, Pc = combine(xc, Pc, inn, beta)
             misses = np.where(hit, 0, misses + 1)
             keep = misses < delete_after
             ids, xc, Pc, misses = ids[keep], xc[keep], Pc[keep], misses[keep]
@@ -176,7 +176,7 @@ def multi_target_tracker(model: Any, scans: Any, *, detection_probability: Any, 
             free = np.flatnonzero(~used)
             inn = innovations(C, R, xt, Pt, Z[free])
             assigned = global_assignment(inn.nis, gamma)
-            xt, Pt = combine(xt, Pt, inn, _one_hot(assigned, free.size), C)
+            xt, Pt = combine(xt, Pt, inn, _one_hot(assigned, free.size))
             hit = assigned >= 0
             used[free[assigned[hit]]] = True
             hits, seen = hits + hit, seen + 1
