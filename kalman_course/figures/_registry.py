@@ -46,6 +46,11 @@ CHAPTER_TITLES: dict[str, str] = {
     "filtre-gaussien": "Un seul filtre gaussien : linéarisation, points sigma, cubature, Gauss–Hermite",
     "quel-filtre": "Quel filtre choisir ?",
     "filtrage-parallele": "Filtrer en parallèle dans le temps",
+    # plusieurs cibles (issue 37)
+    "fouillis-association": "Fouillis et association",
+    "gestion-pistes": "Gérer les pistes",
+    "td-plusieurs-cibles": "TD 4 — Plusieurs cibles à la main",
+    "tp-plusieurs-cibles": "TP 5 — Plusieurs cibles : l'association probabiliste (PDA)",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

@@ -38,6 +38,9 @@ DETECTION_PROBABILITIES = (0.6, 0.9)
 GATE_PROBABILITIES = (0.9, 0.95, 0.99)
 #: Règles de confirmation « M sur N » proposées.
 CONFIRM_RULES = ((3, 4), (4, 5), (5, 6))
+#: Bornes du plan (km) : la zone surveillée et une marge, où s'égarent quelques pistes.
+PLANE_EAST = (-9.0, 21.0)
+PLANE_NORTH = (-15.0, 6.0)
 #: Couleurs des cinq avions (trajectoire vraie en clair, pistes en trait plein).
 AIRCRAFT_COLOURS = ("royalblue", "darkorange", "seagreen", "crimson", "purple")
 
@@ -85,7 +88,7 @@ def _readout(series, values) -> str:
 
 
 def _plane_glyphs() -> tuple[Glyph, ...]:
-    glyphs = []
+    glyphs = [Glyph("region_n", "line", "gray", "zone surveillée", x="region_e", width=1.0, dash="dashed")]
     names = tr.truth_names()
     for a, colour in enumerate(AIRCRAFT_COLOURS):
         glyphs.append(Glyph(f"true{a}_n", "line", colour, "", x=f"true{a}_e", width=7.0, alpha=0.25))
@@ -98,10 +101,9 @@ def _plane_glyphs() -> tuple[Glyph, ...]:
 
 
 def _panels() -> tuple[Panel, ...]:
-    e0, e1, n0, n1 = (v / 1e3 for v in tr.REGION)
     return (
         Panel("Pistes confirmées (trajectoires vraies en clair)", "nord (km)", _plane_glyphs(), x_label="est (km)",
-              x_range=(e0, e1), y_range=(n0, n1), equal_aspect=True),
+              x_range=PLANE_EAST, y_range=PLANE_NORTH, equal_aspect=True),
         Panel("GOSPA de chaque relevé et ses composantes (p = 1, c = 1 km)", "GOSPA (m)", (
             Glyph("gospa", "line", "black", "GOSPA", width=2.0),
             Glyph("localisation", "line", "royalblue", "localisation", width=1.5),
@@ -113,7 +115,8 @@ def _panels() -> tuple[Panel, ...]:
 
 def _fixed() -> dict[str, np.ndarray]:
     truth = tr.truth()
-    out = {}
+    e0, e1, n0, n1 = (v / 1e3 for v in tr.REGION)
+    out = {"region_e": np.array([e0, e1, e1, e0, e0]), "region_n": np.array([n0, n0, n1, n1, n0])}
     for a in range(truth.shape[1]):
         out[f"true{a}_e"], out[f"true{a}_n"] = truth[:, a, 0] / 1e3, truth[:, a, 1] / 1e3
     return out

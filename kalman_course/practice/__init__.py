@@ -28,6 +28,7 @@ from typing import Any, Callable, NamedTuple
 
 from .grading import Case, Exercise, Mistake, Output, grade
 from .linear import JOSEPH_UPDATE, KF_PREDICT, KF_UPDATE, NIS
+from .multitarget import PDA_UPDATE, PDA_WEIGHTS
 from .nonlinear import EKF_UPDATE, SO3_EXP, TAG_JACOBIAN
 from .sampling import PARTICLE_WEIGHTS, SIGMA_POINTS, SYSTEMATIC_RESAMPLE, UNSCENTED_TRANSFORM
 from .smoothing import EM_M_STEP, RTS_STEP
@@ -41,6 +42,7 @@ _EXERCISES: tuple[Exercise, ...] = (
     EKF_UPDATE, TAG_JACOBIAN, SO3_EXP,
     SIGMA_POINTS, UNSCENTED_TRANSFORM, SYSTEMATIC_RESAMPLE, PARTICLE_WEIGHTS,
     RTS_STEP, EM_M_STEP,
+    PDA_WEIGHTS, PDA_UPDATE,
 )
 _BY_ID = {ex.id: ex for ex in _EXERCISES}
 

@@ -39,11 +39,12 @@ BOX = (14000.0, 4000.0)
 DETECTION_PROBABILITY = 0.9
 CLUTTER_DENSITY = 2e-8
 ACCEL_PSD = 1.0
-#: Les numéros sont relevés ce nombre de relevés avant le croisement (20 s).
-BEFORE = 4
+#: Les numéros sont relevés ce nombre de relevés avant le croisement (35 s : à 8°, les avions sont encore à 390 m
+#: l'un de l'autre, hors de leurs portes).
+BEFORE = 7
 #: Angle de croisement (degrés) et nombre de tirages de l'étude.
-ANGLE = 5.0
-RUNS = 40
+ANGLE = 8.0
+RUNS = 30
 #: Issues d'un tirage.
 OUTCOMES = ("gardées", "échangées", "autre")
 

@@ -10,7 +10,9 @@ Le code de l'étudiant n'interrompt jamais l'expérience : s'il échoue, ``stude
 * :func:`tag_lab` — TP 2 : l'EKF du tag avec la correction et la jacobienne de l'étudiant ;
 * :func:`pendulum_lab` — TP 3 : un UKF (points sigma et transformée de l'étudiant) et un filtre
   particulaire (poids et rééchantillonnage de l'étudiant) sur le pendule ;
-* :func:`nile_lab` — TP 4 : le lisseur RTS et l'étape M de l'étudiant sur le Nil.
+* :func:`nile_lab` — TP 4 : le lisseur RTS et l'étape M de l'étudiant sur le Nil ;
+* :func:`pda_lab` — TP 5 : les poids et la correction PDA de l'étudiant, sur l'hélicoptère de la scène de
+  Blagnac dans un fouillis dense.
 """
 
 from __future__ import annotations
@@ -37,8 +39,9 @@ from .tag import TAG_RANGE_STD, tag_data, tag_model, tag_ranges
 from .voltage import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
 
 __all__ = [
-    "LabRun", "voltage_lab", "tag_lab", "pendulum_lab", "nile_lab",
+    "LabRun", "voltage_lab", "tag_lab", "pendulum_lab", "nile_lab", "pda_lab",
     "LAB_UKF", "LAB_PARTICLES", "LAB_PF_SEED", "LAB_NILE_PRIOR", "LAB_EM_START", "LAB_EM_ITERATIONS",
+    "LAB_PDA_CLUTTER",
 ]
 
 #: Points sigma de l'UKF du TP 3 : :math:`\alpha = 1`, :math:`\beta = 2`, :math:`\kappa = 0`.
@@ -51,6 +54,8 @@ LAB_NILE_PRIOR = (np.array([1000.0]), np.array([[1e6]]))
 #: Départ d'EM du TP 4 : :math:`(\sigma^2_\varepsilon, \sigma^2_\eta)`, et nombre d'itérations.
 LAB_EM_START = (1e4, 1e3)
 LAB_EM_ITERATIONS = 30
+#: Densité du fouillis du TP 5 (par m² et par relevé : 44 fausses détections par relevé sur la zone).
+LAB_PDA_CLUTTER = 1e-7
 
 
 @dataclass(frozen=True, eq=False)
@@ -256,3 +261,54 @@ def nile_lab(rts_step: Callable | None = None, m_step: Callable | None = None) -
     message = " ; ".join(m for m in messages if m) or None
     return LabRun({"year": np.asarray(series.year), "y": y}, reference, student, message)
 
+
+# --------------------------------------------------------------------------- TP 5 : la PDA
+
+
+def pda_lab(pda_weights: Callable | None = None, pda_update: Callable | None = None) -> LabRun:
+    r"""Un filtre PDA sur l'hélicoptère SAMU 31 de la scène de Blagnac (:mod:`~kalman_course.scenarios.traffic`,
+    :math:`P_D` = 0,9, fouillis :data:`LAB_PDA_CLUTTER`, porte 0,99) : à chaque relevé, prédiction du paquet,
+    puis les poids ``pda_weights`` et la correction ``pda_update`` de l'étudiant, contre
+    :func:`~kalman_course.pda_update`. Les détections des autres avions sont, pour ce filtre, du fouillis.
+    L'a priori est la position et la vitesse vraies au premier relevé, avec la covariance d'une naissance
+    par deux points. ``data`` : ``t``, ``truth`` (K, 2), ``detections`` (points des relevés à moins de 1,5 km
+    de l'hélicoptère) ; ``reference`` et ``student`` : ``x`` (K, 2) et ``error`` (K,) m."""
+    from ..multitarget.pda import pda_update as package_pda_update
+    from . import traffic
+
+    pda_weights, pda_update = _solution("pda-weights", pda_weights), _solution("pda-update", pda_update)
+    model = traffic.radar_model()
+    scans = traffic.radar_scans(traffic.DETECTION_PROBABILITY, LAB_PDA_CLUTTER)
+    truth = scans.truth[:, 0]
+    A, C, Q, R = (np.array(model.A), np.array(model.C), np.array(model.Q), np.array(model.R))
+    dt = traffic.DT
+    x0 = np.concatenate([truth[0], (truth[1] - truth[0]) / dt])
+    P0 = np.block([[R, R / dt], [R / dt, 2.0 * R / dt ** 2]])
+    settings = dict(detection_probability=traffic.DETECTION_PROBABILITY, clutter_density=LAB_PDA_CLUTTER,
+                    gate_probability=traffic.GATE_PROBABILITY)
+
+    def package():
+        x, P, out = x0, P0, [x0[:2]]
+        for z in scans.scans[1:]:
+            x, P = A @ x, A @ P @ A.T + Q
+            step = package_pda_update(model, x, P, z, **settings)
+            x, P = step.x, step.P
+            out.append(x[:2])
+        return np.array(out)
+
+    def run():
+        x, P, out = x0.copy(), P0.copy(), [x0[:2]]
+        for z in scans.scans[1:]:
+            x, P = A @ x, A @ P @ A.T + Q
+            S = C @ P @ C.T + R
+            beta = np.asarray(pda_weights(z - C @ x, S, *settings.values()), dtype=float)
+            x, P = pda_update(x, P, z, C, R, beta)
+            x, P = np.asarray(x, dtype=float).reshape(4), np.asarray(P, dtype=float).reshape(4, 4)
+            out.append(x[:2])
+        return {"x": np.array(out), "error": np.linalg.norm(np.array(out) - truth, axis=1)}
+
+    ref = package()
+    student, message = _run(run)
+    near = np.vstack([z[np.linalg.norm(z - truth[k], axis=1) < 1500.0] for k, z in enumerate(scans.scans)])
+    data = {"t": scans.t, "truth": truth, "detections": near}
+    return LabRun(data, {"x": ref, "error": np.linalg.norm(ref - truth, axis=1)}, student, message)

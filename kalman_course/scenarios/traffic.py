@@ -65,9 +65,9 @@ AREA = (REGION[1] - REGION[0]) * (REGION[3] - REGION[2])
 SEED = 37
 #: Densité maximale de fausses détections (par m² et par relevé : 44 par relevé en moyenne sur la zone).
 MAX_CLUTTER = 1e-7
-#: Réglages par défaut : densité du fouillis (par m² : 8,8 fausses détections par relevé), probabilités de
+#: Réglages par défaut : densité du fouillis (par m² : 13 fausses détections par relevé), probabilités de
 #: détection et de la porte.
-CLUTTER_DENSITY = 2e-8
+CLUTTER_DENSITY = 3e-8
 DETECTION_PROBABILITY = 0.9
 GATE_PROBABILITY = 0.99
 #: Densité d'accélération du modèle du pisteur (m²/s³) : un virage au taux standard (3°/s) à 90 m/s demande

@@ -12,7 +12,9 @@ et les tests (qui comparent les deux).
 * :func:`ensemble_spread` — TD 2 : la dispersion de l'analyse d'un EnKF scalaire, avec et sans
   perturbation des observations ;
 * :func:`three_step_smoothing` — TD 3 : trois pas de filtre et de lisseur RTS sur une marche aléatoire,
-  puis l'étape M de R.
+  puis l'étape M de R ;
+* :func:`pda_by_hand` — TD 4 : une correction PDA scalaire avec deux détections ;
+* :func:`jpda_by_hand` — TD 4 : les probabilités JPDA de deux pistes et deux détections, par énumération.
 """
 
 from __future__ import annotations
@@ -27,10 +29,13 @@ from ..filters.particle import systematic_resample
 from ..filters.smoothers import rts_smoother
 from ..filters.unscented import unscented_transform
 from ..likelihood import em_step
+from ..multitarget.jpda import joint_marginals
+from ..multitarget.pda import PDAUpdate, pda_update
 
 __all__ = [
     "THERMOMETER", "SQUARE_UT", "FOUR_WEIGHTS", "FOUR_U", "ENSEMBLE_EXAMPLE", "THREE_STEPS",
     "thermometer_update", "square_transform", "four_particles", "ensemble_spread", "three_step_smoothing",
+    "PDA_BY_HAND", "JPDA_WEIGHTS", "pda_by_hand", "jpda_by_hand",
 ]
 
 #: TD 1 : a priori (°C), sa variance (°C²), mesure (°C), variance de la mesure (°C²).
@@ -45,6 +50,13 @@ FOUR_U = 0.5
 ENSEMBLE_EXAMPLE = {"P_prior": 4.0, "R": 1.0, "members": 200_000, "seed": 5}
 #: TD 3 : marche aléatoire x_{k+1} = x_k + w_k, y_k = x_k + v_k, Q = R = 1, a priori N(0, 1), mesures.
 THREE_STEPS = {"Q": 1.0, "R": 1.0, "x0": 0.0, "P0": 1.0, "y": (1.0, 3.0, 2.0)}
+#: TD 4 : une piste scalaire (a priori 0, variance 3), R = 1, deux détections ; P_D, P_G et λ (par unité de
+#: longueur).
+PDA_BY_HAND = {"x_prior": 0.0, "P_prior": 3.0, "R": 1.0, "detections": (1.0, -2.0), "P_D": 0.8, "P_G": 0.9,
+               "lambda": 0.1}
+#: TD 4 : poids PDA (divisés par w₀) de deux pistes pour deux détections : colonne 0, aucune détection.
+JPDA_WEIGHTS = np.array([[1.0, 4.0, 1.0], [1.0, 2.0, 3.0]])
+JPDA_WEIGHTS.setflags(write=False)
 
 
 def thermometer_update():
@@ -127,3 +139,17 @@ def three_step_smoothing() -> ThreeSteps:
     new = em_step(model, y, [c["x0"]], [[c["P0"]]], None)[1]
     return ThreeSteps(res.x[:, 0], res.P[:, 0, 0], res.x_pred[:, 0], res.P_pred[:, 0, 0], sm.x[:, 0],
                       sm.P[:, 0, 0], sm.G[:-1, 0, 0], float(new.R[0, 0]))
+
+
+def pda_by_hand() -> PDAUpdate:
+    """La correction PDA du TD 4 par :func:`kalman_course.pda_update` (modèle scalaire, C = 1)."""
+    c = PDA_BY_HAND
+    model = LinearGaussianModel(1.0, 1.0, 0.0, c["R"])
+    return pda_update(model, [c["x_prior"]], [[c["P_prior"]]], np.array(c["detections"])[:, None],
+                      detection_probability=c["P_D"], clutter_density=c["lambda"], gate_probability=c["P_G"])
+
+
+def jpda_by_hand() -> np.ndarray:
+    """Les probabilités JPDA (2, 3) du TD 4, par l'énumération du paquet
+    (:func:`kalman_course.multitarget.jpda.joint_marginals`) sur les poids :data:`JPDA_WEIGHTS`."""
+    return joint_marginals(np.array(JPDA_WEIGHTS), np.array(JPDA_WEIGHTS)[:, 1:] > 0)
