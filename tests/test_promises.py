@@ -1315,10 +1315,8 @@ def _association_low_detection_probability():
     assert _summary(base)["tracks"] == 5 and _summary(low)["tracks"] > 5  # des pistes renaissent
     tr, _ = _traffic()
     segments = 0
-    for a in range(5):  # plusieurs tronçons d'une même couleur
-        alive = np.zeros(tr.N_SCANS, dtype=bool)
-        for j in range(tr.TRACK_SLOTS):
-            alive |= np.isfinite(low[f"a{a}s{j}_e"])
+    for a in range(5):  # plusieurs tronçons d'une même couleur (lignes de K relevés, séparées par NaN)
+        alive = np.isfinite(low[f"a{a}_e"].reshape(tr.TRACK_SLOTS, tr.N_SCANS + 1)[:, :-1]).any(axis=0)
         segments = max(segments, int(np.sum(np.diff(alive.astype(int)) == 1)) + int(alive[0]))
     assert segments >= 2
     assert _summary(low)["missed"] > 2 * _summary(base)["missed"]  # la composante grandit

@@ -93,9 +93,7 @@ def _plane_glyphs() -> tuple[Glyph, ...]:
     for a, colour in enumerate(AIRCRAFT_COLOURS):
         glyphs.append(Glyph(f"true{a}_n", "line", colour, "", x=f"true{a}_e", width=7.0, alpha=0.25))
     for a, colour in enumerate(AIRCRAFT_COLOURS):
-        for j in range(tr.TRACK_SLOTS):
-            glyphs.append(Glyph(f"a{a}s{j}_n", "line", colour, f"pistes de {names[a]}" if j == 0 else "",
-                                x=f"a{a}s{j}_e", width=1.8))
+        glyphs.append(Glyph(f"a{a}_n", "line", colour, f"pistes de {names[a]}", x=f"a{a}_e", width=1.8))
     glyphs.append(Glyph("false_n", "scatter", "black", "fausses pistes", x="false_e", marker="dot", size=6))
     return tuple(glyphs)
 

@@ -10,7 +10,8 @@ d'innovation :math:`S_t = CP_tC^T + R`. Pour une détection :math:`z_j` (notatio
 
 Si :math:`z_j` vient de la cible, :math:`d^2_{tj}` suit une loi du :math:`\chi^2` à :math:`m` degrés de
 liberté : la détection est **dans la porte** si :math:`d^2_{tj} \le \gamma`, avec
-:math:`\gamma = \chi^2_m(P_G)` (``scipy.stats.chi2.ppf``) ; la vraie détection y tombe avec la probabilité
+:math:`\gamma = \chi^2_m(P_G)` (le ``scipy.stats.chi2.ppf`` de scipy, calculé une fois par
+:func:`~kalman_course.filters.gating.gate_threshold`) ; la vraie détection y tombe avec la probabilité
 :math:`P_G`. La porte est l'ellipsoïde :math:`\{z : (z - C\hat x_t)^TS_t^{-1}(z - C\hat x_t) \le \gamma\}`,
 de volume
 
@@ -32,11 +33,11 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.special
-import scipy.stats
 
 from ..core.models import LinearGaussianModel
 from ..core.models import _each_step as each_step
 from ..core.results import freeze
+from ..filters.gating import gate_threshold
 from ..core.validation import (
     KalmanInputError,
     as_float_array,
@@ -119,9 +120,12 @@ def check_tracks(x_pred: Any, P_pred: Any, n: int, *, single: bool = False) -> t
         if P.shape != (T, n, n):
             raise KalmanInputError(f"« P_pred » doit être de forme ({T}, {n}, {n}) : une covariance par piste de "
                                    f"« x_pred » ; reçu {shape_text(P.shape)}.")
-    if P.shape[0]:  # symétrie et positivité de toutes à la fois ; la première fautive nommée
-        psd = lambda name, M: check_psd(name, as_square_matrix(name, M, n))  # noqa: E731
-        P = psd("P_pred", P[0])[None] if single else each_step("P_pred", P, P.shape[0], psd, "psd")
+    if P.shape[0]:  # symétrie et positivité de toutes à la fois (en pile) ; la première fautive nommée
+        if single:
+            psd = lambda _, M: check_psd("P_pred", as_square_matrix("P_pred", M, n))  # noqa: E731
+        else:
+            psd = lambda name, M: check_psd(name, as_square_matrix(name, M, n))  # noqa: E731
+        P = each_step("P_pred", P, P.shape[0], psd, "psd")
     return x, P
 
 
@@ -138,11 +142,6 @@ def check_detections(detections: Any, m: int, name: str = "detections") -> np.nd
 
 
 # --------------------------------------------------------------------------- calculs
-
-
-def gate_threshold(gate_probability: float, m: int) -> float:
-    r"""Le seuil :math:`\gamma = \chi^2_m(P_G)` (``scipy.stats.chi2.ppf``)."""
-    return float(scipy.stats.chi2.ppf(gate_probability, m))
 
 
 def gate_volume(gamma: float, log_det_S: np.ndarray, m: int) -> np.ndarray:

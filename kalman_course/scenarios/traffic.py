@@ -277,10 +277,11 @@ FALSE_SLOTS = 16
 def track_series(run: TrackingRun) -> dict[str, np.ndarray]:
     r"""Les pistes d'une exécution, prêtes à tracer à longueur fixe (toutes de longueur K) :
 
-    * ``"a{i}s{j}_e"``, ``"a{i}s{j}_n"`` (km) : la ligne ``j`` (< :data:`TRACK_SLOTS`) des pistes **de
-      l'avion** ``i`` — celles dont le premier avion couplé (GOSPA) est ``i`` —, NaN hors d'une piste. Une
-      piste prend la ligne libre depuis le plus longtemps, avec au moins un relevé vide entre deux pistes
-      (les lignes ne relient jamais deux pistes) ;
+    * ``"a{i}_e"``, ``"a{i}_n"`` (TRACK_SLOTS · (K + 1),) km : les pistes **de l'avion** ``i`` — celles dont le
+      premier avion couplé (GOSPA) est ``i`` —, rangées en :data:`TRACK_SLOTS` lignes de K relevés mises bout à
+      bout, chacune suivie d'un NaN (une seule courbe par avion, coupée entre les lignes). Une piste prend la
+      ligne libre depuis le plus longtemps, avec au moins un relevé vide entre deux pistes (une ligne ne relie
+      jamais deux pistes) ;
     * ``"false_e"``, ``"false_n"`` (K · :data:`FALSE_SLOTS`) km : les positions des **fausses pistes** (jamais
       couplées à un avion), relevé par relevé, NaN pour compléter.
 
@@ -294,7 +295,7 @@ def track_series(run: TrackingRun) -> dict[str, np.ndarray]:
         for i, track in enumerate(ids):
             first, _, rows = span.get(int(track), (k, k, []))
             span[int(track)] = (first, k, rows + [(k, i)])
-    out = {f"a{a}s{j}_{c}": np.full(K, np.nan) for a in range(A) for j in range(TRACK_SLOTS) for c in "en"}
+    lines = {c: np.full((A, TRACK_SLOTS, K + 1), np.nan) for c in "en"}
     false_e, false_n = np.full((K, FALSE_SLOTS), np.nan), np.full((K, FALSE_SLOTS), np.nan)
     free_since = {(a, j): -2 for a in range(A) for j in range(TRACK_SLOTS)}
     for track in sorted(span, key=lambda t: span[t][0]):
@@ -307,13 +308,14 @@ def track_series(run: TrackingRun) -> dict[str, np.ndarray]:
             j = min(slots, key=lambda s: free_since[(a, s)])
             free_since[(a, j)] = last
             for k, i in rows:
-                out[f"a{a}s{j}_e"][k], out[f"a{a}s{j}_n"][k] = run.tracks.x[k][i, :2] / 1e3
+                lines["e"][a, j, k], lines["n"][a, j, k] = run.tracks.x[k][i, :2] / 1e3
         else:
             for k, i in rows:
                 place = np.flatnonzero(np.isnan(false_e[k]))
                 if place.size == 0:
                     raise RuntimeError(f"plus de {FALSE_SLOTS} fausses pistes au relevé {k} (FALSE_SLOTS)")
                 false_e[k, place[0]], false_n[k, place[0]] = run.tracks.x[k][i, :2] / 1e3
+    out = {f"a{a}_{c}": lines[c][a].ravel() for a in range(A) for c in "en"}
     out["false_e"], out["false_n"] = false_e.ravel(), false_n.ravel()
     return out
 
