@@ -114,6 +114,7 @@ def gate_snapshot_figure():
         ax.plot([], [], "-", color="0.3", label="affectation du NN (flèche pleine)")
         ax.plot([], [], ":", color="0.3", label="affectation du GNN (flèche pointillée)")
         _plane(ax, "m")
+        ax.set_aspect("equal", adjustable="box")  # bornes fixées : le cadre s'ajuste, pas les bornes
         ax.set_xlim(-half, half)
         ax.set_ylim(-half, half)
         ax.set_xlabel(f"est (m, depuis {fr(centre[0] / 1e3, '.1f')} km)")
