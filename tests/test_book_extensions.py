@@ -170,3 +170,32 @@ def test_a_formula_mathjax_refuses_names_its_page(tmp_path, mathjax_settings):
     _, problems = typeset_pages([page], **mathjax_settings)
     assert problems == ["td.html : « \\hatx + 1 » : commande inconnue \\hatx",
                         "td.html : « \\frac{1}{ » : Missing close brace"]
+
+
+def test_proofs_get_a_french_title_and_their_own_ids():
+    """sphinx-proof écrit ``{prf:proof}`` sans titre, « Proof. » en tête du texte et l'identifiant ``proof`` pour
+    toutes : l'extension des pages leur donne le titre « Démonstration » (que le script des encadrés
+    ``dropdown`` replie) et un identifiant par démonstration (issue 37)."""
+    from docutils import nodes
+    from docutils.frontend import get_default_settings
+    from docutils.parsers.rst import Parser
+    from docutils.utils import new_document
+
+    from kalman_course.sphinx.pages import PROOF_TITLE, french_proof
+
+    document = new_document("chapitre", get_default_settings(Parser))
+    for _ in range(2):
+        proof = nodes.admonition(classes=["proof", "proof", "dropdown"], ids=["proof"])
+        proof += nodes.paragraph("", "", nodes.Text("Proof. Sachant "), nodes.emphasis("", "θ"))
+        document += proof
+        document.ids["proof"] = proof
+    proofs = list(document.findall(nodes.admonition))
+    for proof in proofs:
+        french_proof(proof, document)
+    assert [p[0].astext() for p in proofs] == [PROOF_TITLE] * 2 and isinstance(proofs[0][0], nodes.title)
+    assert [p[1].astext() for p in proofs] == ["Sachant θ"] * 2
+    ids = [p["ids"] for p in proofs]
+    assert len(ids[0]) == len(ids[1]) == 1 and ids[0] != ids[1] and "proof" not in document.ids
+    french_proof(proofs[0], document)  # une seconde fois : rien ne change
+    assert proofs[0][0].astext() == PROOF_TITLE and len(proofs[0]) == 2
+

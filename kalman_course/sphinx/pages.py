@@ -32,6 +32,11 @@ chapitre » donne ces lignes d'importation, à copier d'abord.
 
 **Recherche.** Les extraits des résultats de recherche montrent les formules en texte lisible
 (« P⁻ », pas « \(P^-\) »).
+
+**Démonstrations.** sphinx-proof écrit ``{prf:proof}`` sans titre, avec « Proof. » collé au texte et le
+même identifiant ``proof`` pour toutes (le script qui replie les encadrés ``:class: dropdown`` cherche un
+titre, et deux identifiants égaux sont une faute d'accessibilité) : :func:`french_proof` lui donne le titre
+« Démonstration », retire « Proof. » et un identifiant propre à chaque démonstration.
 """
 
 from __future__ import annotations
@@ -41,10 +46,12 @@ import json
 import re
 from pathlib import Path
 
+from docutils import nodes
+from sphinx.transforms import SphinxTransform
 from sphinx.util import logging
 
 __all__ = ["setup", "ASSETS", "css_glyphs", "icon_css", "fontawesome_icons", "hidden_imports", "subset_fonts", "imports_block", "mermaid_alt",
-           "extract_figure_data"]
+           "extract_figure_data", "french_proof", "PROOF_TITLE"]
 
 LOGGER = logging.getLogger(__name__)
 
@@ -332,7 +339,39 @@ def _write_icons(app, exception) -> None:
     target.write_text(icon_css(used, icons) + subset_fonts(outdir / "_static", glyphs))
 
 
+#: Le titre des démonstrations (``{prf:proof}``).
+PROOF_TITLE = "Démonstration"
+
+
+def french_proof(node: nodes.admonition, document) -> None:
+    """Une démonstration de sphinx-proof (``nodes.admonition`` de classes ``proof``, identifiant ``proof``) en
+    français : titre :data:`PROOF_TITLE` en tête, « Proof. » retiré du premier paragraphe, identifiant
+    ``demonstration-1``, ``demonstration-2``… unique dans le document."""
+    first = node.next_node(nodes.paragraph)
+    if first is not None and first.children and isinstance(first[0], nodes.Text) \
+            and first[0].astext().startswith("Proof. "):
+        first[0] = nodes.Text(first[0].astext()[len("Proof. "):])
+    if not (node.children and isinstance(node[0], nodes.title)):
+        node.insert(0, nodes.title("", PROOF_TITLE))
+    for old in node["ids"]:
+        document.ids.pop(old, None)
+    node["ids"] = []
+    document.set_id(node, suggested_prefix="demonstration")  # (l'ajoute à node["ids"])
+
+
+class FrenchProofs(SphinxTransform):
+    """Applique :func:`french_proof` à chaque démonstration de sphinx-proof."""
+
+    default_priority = 700
+
+    def apply(self, **kwargs) -> None:
+        for node in list(self.document.findall(nodes.admonition)):
+            if "proof" in node["classes"] and node["ids"] == ["proof"]:
+                french_proof(node, self.document)
+
+
 def setup(app):
+    app.add_transform(FrenchProofs)
     app.connect("config-inited", _configure)
     app.connect("builder-inited", _static_path)
     # avant le dédoublonnage des scripts de sphinx_ext (900), qui remplace la liste du contexte
