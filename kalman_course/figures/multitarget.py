@@ -11,6 +11,7 @@ from ..multitarget.gate import gate_threshold
 from ..numbers import format_spec as fr
 from ..scenarios import crossing as cr
 from ..scenarios import traffic as tr
+from ..scenarios import tutorials
 from ._geometry import ellipse_points
 from ._registry import new_figure, register
 
@@ -223,4 +224,45 @@ def gospa_figure():
         ax.grid(alpha=0.3)
         ax.legend(loc="upper right", fontsize=7)
     axes[0].set_ylabel("GOSPA (m)")
+    return fig
+
+
+# --------------------------------------------------------------------------- TD 4
+
+
+@register("td-pda", chapter="td-plusieurs-cibles",
+          title="TD 4 : la correction PDA à la main — un mélange de trois gaussiennes et sa gaussienne résumée")
+def pda_by_hand_figure():
+    c = tutorials.PDA_BY_HAND
+    step = tutorials.pda_by_hand()
+    beta = step.weights
+    x0, P0, R = c["x_prior"], c["P_prior"], c["R"]
+    S = P0 + R
+    K = P0 / S
+    z = np.array(c["detections"])
+    gamma = gate_threshold(c["P_G"], 1)
+    means = np.r_[x0, x0 + K * (z - x0)]
+    variances = np.r_[P0, np.full(z.size, (1 - K) * P0)]
+    grid = np.linspace(-6.0, 6.0, 1201)
+    parts = [b * scipy.stats.norm(m, np.sqrt(v)).pdf(grid) for b, m, v in zip(beta, means, variances)]
+    fig, ax = new_figure(width=7.5, height=3.8)
+    half = np.sqrt(gamma * S)
+    ax.axvspan(x0 - half, x0 + half, color="0.92", label=f"porte (P_G = {fr(c['P_G'], '.1f')})")
+    ax.plot(grid, scipy.stats.norm(x0, np.sqrt(P0)).pdf(grid), color="0.4", ls=":", lw=1.5,
+            label="prédiction N(0 ; 3)")
+    for j, (part, style) in enumerate(zip(parts, ("--", "-.", "-."))):
+        ax.plot(grid, part, ls=style, lw=1.2, color=("0.5", "tab:orange", "tab:green")[j],
+                label=("β₀ × prédiction" if j == 0 else f"β{j} × Kalman avec z{j}") + f" (β = {fr(beta[j], '.3f')})")
+    ax.plot(grid, sum(parts), color="black", lw=2.0, label="loi a posteriori : le mélange")
+    ax.plot(grid, scipy.stats.norm(step.x[0], np.sqrt(step.P[0, 0])).pdf(grid), color="tab:blue", lw=2.0,
+            label=f"PDA : N({fr(step.x[0], '.3f')} ; {fr(step.P[0, 0], '.3f')})")
+    for j, zj in enumerate(z, start=1):
+        ax.axvline(zj, color=("tab:orange", "tab:green")[j - 1], lw=1.0)
+        ax.annotate(f"z{j} = {fr(zj, '.0f')}", (zj, 0.5), xytext=(4, 0), textcoords="offset points", fontsize=8)
+    ax.set_xlabel("position (sans unité)")
+    ax.set_ylabel("densité (sans unité)")
+    ax.set_xlim(-6.0, 6.0)
+    ax.set_ylim(0.0, 0.55)
+    ax.legend(loc="upper left", fontsize=7)
+    ax.grid(alpha=0.3)
     return fig
