@@ -720,3 +720,20 @@ def test_the_course_never_imports_stonesoup():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.strip() == "[0]"
+
+
+def test_event_count_is_the_number_of_partial_matchings():
+    """k pistes qui voient les mêmes k détections : Σ C(k, i)² i! événements (couplages partiels) ; des grappes
+    indépendantes multiplient leurs nombres."""
+    from kalman_course.multitarget.jpda import count_events
+
+    for k in range(1, 7):
+        assert count_events(np.ones((k, k), dtype=bool)) == sum(math.comb(k, i) ** 2 * math.factorial(i)
+                                                                 for i in range(k + 1))
+    two_clusters = np.zeros((4, 4), dtype=bool)
+    two_clusters[:2, :2] = True
+    two_clusters[2:, 2:] = True
+    assert count_events(two_clusters) == 7 * 7
+    assert count_events(np.zeros((3, 2), dtype=bool)) == 1
+    lone = np.array([[True, False, True]])
+    assert count_events(lone) == 3

@@ -164,13 +164,6 @@ def crossing_figure():
 # --------------------------------------------------------------------------- gérer les pistes
 
 
-def confirmation_probability(p_hit: np.ndarray, M: int, N: int) -> np.ndarray:
-    r"""Probabilité qu'une piste provisoire soit confirmée (« M sur N », les deux détections de naissance
-    comptant pour deux touches) quand elle touche à chaque relevé avec la probabilité ``p_hit`` :
-    :math:`P[\mathrm{Bin}(N - 2, p) \ge M - 2]` (``scipy.stats.binom``)."""
-    return scipy.stats.binom.sf(M - 3, N - 2, p_hit)
-
-
 @register("pistes-confirmation", chapter=MANAGEMENT_CHAPTER,
           title="Confirmer une piste : « M sur N » pour une vraie cible et pour une piste née du fouillis")
 def confirmation_figure():
@@ -190,9 +183,9 @@ def confirmation_figure():
     p_true = traffic.DETECTION_PROBABILITY * traffic.GATE_PROBABILITY
     fig, ax = new_figure(width=7.0, height=3.8)
     for (M, N), style in zip(((3, 4), (4, 5), (5, 6)), ("-", "--", ":")):
-        ax.plot(per_scan, confirmation_probability(p_false, M, N), ls=style, color="crimson", lw=1.8,
+        ax.plot(per_scan, tr.confirmation_probability(p_false, M, N), ls=style, color="crimson", lw=1.8,
                 label=f"piste née du fouillis, {M} sur {N}")
-        ax.axhline(confirmation_probability(np.array(p_true), M, N), ls=style, color="royalblue", lw=1.4,
+        ax.axhline(tr.confirmation_probability(np.array(p_true), M, N), ls=style, color="royalblue", lw=1.4,
                    label=f"vraie cible, {M} sur {N}")
     for density_mark in (3e-8, 1e-7):
         ax.axvline(density_mark * traffic.AREA, color="0.5", lw=0.8)

@@ -20,7 +20,7 @@ autre) sont indépendantes : le graphe pistes–détections de la porte se coupe
 chaque événement partiel est prolongé par chacune de ses options, et ceux qui réutilisent une détection
 (un bit déjà levé dans leur masque) sont retirés. Le nombre d'événements croît comme celui des couplages
 partiels d'un graphe biparti : pour :math:`k` pistes qui voient toutes les mêmes :math:`k` détections,
-:math:`\sum_i \binom{k}{i}^2 i!` — 7 pour :math:`k = 2`, 1 546 851 pour :math:`k = 8`, 2,3 × 10⁸ pour
+:math:`\sum_i \binom{k}{i}^2 i!` — 7 pour :math:`k = 2`, 1 441 729 pour :math:`k = 8`, 2,3 × 10⁸ pour
 :math:`k = 10` (``benchmarks/jpda_vs_stonesoup.py`` mesure où le calcul cesse d'être utilisable). Au-delà de
 :data:`MAX_EVENTS` événements dans une grappe, le calcul exact est refusé (erreur française) plutôt que
 d'épuiser la mémoire : jamais d'approximation silencieuse.
@@ -39,7 +39,7 @@ from ..core.validation import KalmanInputError
 from .gate import check_detections, check_model, check_tracks, gate_threshold, innovations
 from .pda import association_weights, check_clutter
 
-__all__ = ["MAX_EVENTS", "jpda_probabilities", "joint_marginals", "clusters"]
+__all__ = ["MAX_EVENTS", "jpda_probabilities", "joint_marginals", "joint_events", "count_events", "clusters"]
 
 #: Nombre maximal d'événements conjoints énumérés dans une grappe (au-delà : KalmanInputError).
 MAX_EVENTS = 20_000_000
@@ -66,18 +66,17 @@ def clusters(inside: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
-def _cluster_marginals(w: np.ndarray) -> np.ndarray:
-    r"""Marginales exactes d'une grappe : ``w`` (T_c, N_c + 1) poids des options de ses pistes (colonne 0 :
-    aucune détection ; un poids nul : option impossible, hors de la porte). Renvoie :math:`\beta`
-    (T_c, N_c + 1), lignes de somme 1.
+def joint_events(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    r"""Tous les événements conjoints d'une grappe : ``w`` (T_c, N_c + 1) poids des options de ses pistes
+    (colonne 0 : aucune détection ; un poids nul : option impossible, hors de la porte). Renvoie ``choice``
+    (E, T_c), l'option de chaque piste dans chacun des E événements, et ``weight`` (E,), leur poids
+    :math:`\prod_t w_{t,a(t)}`.
 
     Les événements partiels sont des lignes de tableaux : ``choice`` (option de chaque piste déjà vue),
     ``used`` (masque des détections prises, un mot de 64 bits par tranche de 64 détections), ``weight``
     (produit des poids). Chaque piste prolonge chaque ligne par chacune de ses options ; une option dont
     le bit est déjà levé est retirée."""
     T_c, n_options = w.shape
-    if T_c == 1:  # une piste seule : ses poids PDA normalisés
-        return w / w.sum()
     words = max(1, -(-(n_options - 1) // 64))
     choice = np.zeros((1, 0), dtype=np.int32)
     used = np.zeros((1, words), dtype=np.uint64)
@@ -101,6 +100,29 @@ def _cluster_marginals(w: np.ndarray) -> np.ndarray:
         used = used[rows]
         used[np.arange(rows.size), word] |= bit
         weight = weight[rows] * w[t, opt]
+    return choice, weight
+
+
+def count_events(inside) -> int:
+    r"""Le nombre d'événements conjoints que la JPDA exacte énumère pour la porte ``inside`` (T, N) booléen :
+    le produit, sur les grappes, du nombre d'événements de chacune (une piste sans détection n'a qu'un
+    événement, « aucune »). Pour :math:`k` pistes qui voient les mêmes :math:`k` détections,
+    :math:`\sum_{i=0}^k\binom{k}{i}^2\,i!`."""
+    inside = np.asarray(inside, dtype=bool)
+    total = 1
+    for tracks, dets in clusters(inside):
+        w = np.hstack([np.ones((tracks.size, 1)), inside[np.ix_(tracks, dets)].astype(float)])
+        total *= joint_events(w)[0].shape[0]
+    return total
+
+
+def _cluster_marginals(w: np.ndarray) -> np.ndarray:
+    r"""Marginales exactes d'une grappe (``w`` : voir :func:`joint_events`) : :math:`\beta` (T_c, N_c + 1),
+    lignes de somme 1."""
+    T_c, n_options = w.shape
+    if T_c == 1:  # une piste seule : ses poids PDA normalisés
+        return w / w.sum()
+    choice, weight = joint_events(w)
     total = weight.sum()
     return np.stack([np.bincount(choice[:, t], weights=weight, minlength=n_options) for t in range(T_c)]) / total
 

@@ -34,6 +34,7 @@ from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
+import scipy.stats
 
 from ..core.models import LinearGaussianModel
 from ..core.motion import constant_velocity_model
@@ -50,7 +51,7 @@ __all__ = [
     "DT", "N_SCANS", "NOISE_STD", "REGION", "AREA", "SEED", "MAX_CLUTTER", "CLUTTER_DENSITY", "DETECTION_PROBABILITY",
     "GATE_PROBABILITY", "ACCEL_PSD", "MAX_SPEED", "GOSPA_CUTOFF", "PERSIST", "CONFIRM", "DELETE_AFTER", "RadarScans",
     "TrackingRun", "scan_times", "truth", "truth_names", "radar_model", "radar_scans", "track_scene", "identity_changes",
-    "TRACK_SLOTS", "FALSE_SLOTS", "track_owners", "track_series", "SNAPSHOT_SCAN", "Snapshot", "scan_snapshot",
+    "TRACK_SLOTS", "FALSE_SLOTS", "track_owners", "track_series", "confirmation_probability", "SNAPSHOT_SCAN", "Snapshot", "scan_snapshot",
 ]
 
 #: Période de rotation du radar (s) et nombre de relevés (de 0 à 300 s).
@@ -365,3 +366,10 @@ def scan_snapshot(k: int = SNAPSHOT_SCAN) -> Snapshot:
                     nn_assign(model, x_pred, P_pred, z, gate_probability=GATE_PROBABILITY),
                     gnn_assign(model, x_pred, P_pred, z, gate_probability=GATE_PROBABILITY), pda,
                     jpda_probabilities(model, x_pred, P_pred, z, **settings))
+
+
+def confirmation_probability(p_hit, M: int, N: int):
+    r"""Probabilité qu'une piste provisoire soit confirmée par la règle « M sur N » (les deux détections de
+    naissance comptant pour deux touches) quand elle touche à chaque relevé avec la probabilité ``p_hit``,
+    indépendamment : :math:`\mathbb P[\mathrm{Bin}(N - 2, p) \ge M - 2]` (``scipy.stats.binom``)."""
+    return scipy.stats.binom.sf(M - 3, N - 2, p_hit)
