@@ -233,8 +233,12 @@ def bench_cluster(scene: Scene, repeat: int, max_cluster: int) -> None:
         events = sum(math.comb(k, i) ** 2 * math.factorial(i) for i in range(k + 1))
         gate = kc.validation_gate(model, x, P, z, gate_probability=tr.GATE_PROBABILITY)
         assert gate.inside.all()
-        t_ours, beta = best_time(lambda: kc.jpda_probabilities(model, x, P, z, **settings),
-                                 repeat if k < 8 else 1, time.process_time)
+        try:
+            t_ours, beta = best_time(lambda: kc.jpda_probabilities(model, x, P, z, **settings),
+                                     repeat if k < 8 else 1, time.process_time)
+        except kc.KalmanInputError as refused:
+            print(f"{k:3d} {format_spec(events, 'd'):>12s}   refusé : {str(refused).split(' ; ')[0]}")
+            continue
         ss_text, ratio_text = "—", "—"
         if k <= 5:
             tracks = [scene.track(x[t], P[t]) for t in range(k)]

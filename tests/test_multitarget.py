@@ -737,3 +737,27 @@ def test_event_count_is_the_number_of_partial_matchings():
     assert count_events(np.zeros((3, 2), dtype=bool)) == 1
     lone = np.array([[True, False, True]])
     assert count_events(lone) == 3
+
+
+def test_clusters_are_the_connected_components_of_the_gate():
+    """Les grappes de la JPDA sont les composantes connexes du graphe pistes–détections (scipy.sparse.csgraph,
+    référence indépendante), sur des portes tirées au hasard."""
+    import scipy.sparse
+    import scipy.sparse.csgraph
+
+    from kalman_course.multitarget.jpda import clusters
+
+    rng = np.random.default_rng(8)
+    for _ in range(50):
+        T, N = rng.integers(1, 9), rng.integers(0, 9)
+        inside = rng.uniform(size=(T, N)) < 0.2
+        graph = scipy.sparse.bmat([[None, scipy.sparse.csr_matrix(inside.astype(float))],
+                                   [scipy.sparse.csr_matrix(inside.T.astype(float)), None]]) if N else None
+        expected = set()
+        if N:
+            _, label = scipy.sparse.csgraph.connected_components(graph, directed=False)
+            for lab in set(label[:T][inside.any(axis=1)]):
+                members = np.flatnonzero(label == lab)
+                expected.add((tuple(members[members < T]), tuple(members[members >= T] - T)))
+        found = {(tuple(t), tuple(d)) for t, d in clusters(inside)}
+        assert found == expected

@@ -35,14 +35,12 @@ import numpy as np
 import scipy.special
 
 from ..core.models import LinearGaussianModel
-from ..core.models import _each_step as each_step
 from ..core.results import freeze
 from ..filters.gating import gate_threshold
 from ..core.validation import (
     KalmanInputError,
     as_float_array,
     as_probability,
-    as_square_matrix,
     check_instance,
     check_psd,
     shape_text,
@@ -120,12 +118,17 @@ def check_tracks(x_pred: Any, P_pred: Any, n: int, *, single: bool = False) -> t
         if P.shape != (T, n, n):
             raise KalmanInputError(f"« P_pred » doit être de forme ({T}, {n}, {n}) : une covariance par piste de "
                                    f"« x_pred » ; reçu {shape_text(P.shape)}.")
-    if P.shape[0]:  # symétrie et positivité de toutes à la fois (en pile) ; la première fautive nommée
-        if single:
-            psd = lambda _, M: check_psd("P_pred", as_square_matrix("P_pred", M, n))  # noqa: E731
-        else:
-            psd = lambda name, M: check_psd(name, as_square_matrix(name, M, n))  # noqa: E731
-        P = each_step("P_pred", P, P.shape[0], psd, "psd")
+    if P.shape[0]:
+        # symétrie et positivité de toutes à la fois, aux tolérances de check_psd (une valeur propre par
+        # covariance, en pile) ; la première fautive est revérifiée seule, pour son message
+        scale = np.maximum(1.0, np.abs(P).max(axis=(1, 2)))
+        sym = 0.5 * (P + np.swapaxes(P, 1, 2))
+        ok = np.abs(P - np.swapaxes(P, 1, 2)).max(axis=(1, 2)) <= 1e-9 * scale
+        ok &= np.linalg.eigvalsh(sym)[:, 0] >= -1e-10 * scale
+        if not ok.all():
+            k = int(np.argmin(ok))
+            check_psd("P_pred" if single else f"P_pred[{k}]", P[k])
+        P = sym
     return x, P
 
 

@@ -15,7 +15,7 @@ aucune). Chaque piste est ensuite corrigée comme par la PDA, avec ses :math:`\b
 
 **Énumération exacte.** Les pistes qui ne partagent aucune détection (même par l'intermédiaire d'une
 autre) sont indépendantes : le graphe pistes–détections de la porte se coupe en **grappes**
-(composantes connexes, ``scipy.sparse.csgraph``) et les marginales d'une grappe ne dépendent que de ses
+(composantes connexes) et les marginales d'une grappe ne dépendent que de ses
 événements. Dans une grappe, les événements sont construits piste par piste, en tableaux : à chaque piste,
 chaque événement partiel est prolongé par chacune de ses options, et ceux qui réutilisent une détection
 (un bit déjà levé dans leur masque) sont retirés. Le nombre d'événements croît comme celui des couplages
@@ -31,8 +31,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.sparse
-import scipy.sparse.csgraph
 
 from ..core.results import freeze
 from ..core.validation import KalmanInputError
@@ -50,7 +48,7 @@ def clusters(inside: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     ``(pistes, détections)`` (indices croissants) ; chaque piste d'une grappe a au moins une détection dans
     sa porte (les pistes sans détection n'y figurent pas). Deux pistes sont voisines si elles partagent une
     détection (:math:`M = \mathbb 1[\text{inside}\,\text{inside}^T > 0]`) ; les grappes sont les composantes
-    connexes de ce graphe (``scipy.sparse.csgraph``)."""
+    connexes de ce graphe (fermeture transitive de :math:`M`, par produits booléens)."""
     tracks = np.flatnonzero(inside.any(axis=1))
     if tracks.size == 0:
         return []
@@ -58,9 +56,15 @@ def clusters(inside: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     shared = sub @ sub.T > 0.0
     if np.count_nonzero(shared) == tracks.size:  # aucune détection partagée : une grappe par piste
         return [(tracks[i:i + 1], np.flatnonzero(inside[tracks[i]])) for i in range(tracks.size)]
-    labels = scipy.sparse.csgraph.connected_components(scipy.sparse.csr_matrix(shared), directed=False)[1]
+    reach = shared
+    while True:  # fermeture transitive par carrés successifs : au plus log₂ T produits booléens
+        wider = (reach.astype(np.int32) @ reach.astype(np.int32)) > 0
+        if np.array_equal(wider, reach):
+            break
+        reach = wider
+    labels = np.argmax(reach, axis=1)  # le plus petit indice de la composante
     out = []
-    for lab in range(labels.max() + 1):
+    for lab in np.unique(labels):
         members = tracks[labels == lab]
         out.append((members, np.flatnonzero(inside[members].any(axis=0))))
     return out
