@@ -101,7 +101,7 @@ def _plane_glyphs() -> tuple[Glyph, ...]:
 def _panels() -> tuple[Panel, ...]:
     return (
         Panel("Pistes confirmées (trajectoires vraies en clair)", "nord (km)", _plane_glyphs(), x_label="est (km)",
-              x_range=PLANE_EAST, y_range=PLANE_NORTH, equal_aspect=True),
+              x_range=PLANE_EAST, y_range=PLANE_NORTH, equal_aspect=True, width=460),
         Panel("GOSPA de chaque relevé et ses composantes (p = 1, c = 1 km)", "GOSPA (m)", (
             Glyph("gospa", "line", "black", "GOSPA", width=2.0),
             Glyph("localisation", "line", "royalblue", "localisation", width=1.5),
