@@ -137,6 +137,16 @@ from .filters.gauss_hermite import GaussHermiteRule, gauss_hermite_kalman_filter
 from .filters.posterior_linearization import iterated_posterior_linearization_filter
 # filtrer et lisser en parallèle dans le temps (issue 22)
 from .filters.parallel import parallel_kalman_filter, parallel_rts_smoother
+# filtrage invariant sur SE(2) (issue 35)
+from .filters.invariant import (
+    OdometryGnssModel,
+    SE2FilterResult,
+    se2_invariant_ekf,
+    se2_invariant_ekf_runs,
+    se2_standard_ekf,
+    se2_standard_ekf_runs,
+)
+from .geometry.lie import se2_adjoint, se2_exp, se2_left_jacobian, se2_log, se2_right_jacobian
 # plusieurs cibles dans le fouillis : porte, association, gestion des pistes, GOSPA (issue 37)
 from .multitarget import (
     GOSPA,
@@ -309,6 +319,18 @@ __all__ = [
     "iterated_posterior_linearization_filter",
     "parallel_kalman_filter",
     "parallel_rts_smoother",
+    # filtrage invariant sur SE(2)
+    "se2_exp",
+    "se2_log",
+    "se2_adjoint",
+    "se2_right_jacobian",
+    "se2_left_jacobian",
+    "OdometryGnssModel",
+    "SE2FilterResult",
+    "se2_invariant_ekf",
+    "se2_standard_ekf",
+    "se2_invariant_ekf_runs",
+    "se2_standard_ekf_runs",
     # plusieurs cibles dans le fouillis (issue 37)
     "validation_gate",
     "Gate",

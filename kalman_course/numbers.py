@@ -29,6 +29,7 @@ __all__ = [
     "format_percent",
     "format_spec",
     "format_array",
+    "format_fractions",
     "matplotlib_formatter",
     "matplotlib_log_formatter",
     "french_figure",
@@ -211,6 +212,22 @@ def format_array(values: Any, **options: Any) -> str:
     return "[" + "\n ".join(f"[{line}]" for line in lines) + "]"
 
 
+def format_fractions(values: Any, max_denominator: int = 200) -> str:
+    """Des valeurs écrites en fractions, comme les calculs à la main d'un TD : chaque valeur est
+    approchée par la fraction la plus proche de dénominateur au plus ``max_denominator``
+    (:meth:`fractions.Fraction.limit_denominator`), séparées par des virgules, signe moins
+    typographique. ``format_fractions([2/3, 17/8, -0.5])`` → « 2/3, 17/8, −1/2 »."""
+    from fractions import Fraction
+
+    import numpy as np
+
+    _check_digits("max_denominator", max_denominator, 1)
+    arr = np.atleast_1d(np.asarray(values, dtype=float)).ravel()
+    if not np.all(np.isfinite(arr)):
+        raise KalmanInputError("« values » doit contenir des nombres finis (ni NaN ni infini).")
+    return ", ".join(str(Fraction(float(v)).limit_denominator(max_denominator)).replace("-", MINUS) for v in arr)
+
+
 def matplotlib_formatter():
     r"""Formateur de graduations matplotlib (linéaires) en français : les graduations choisies par
     ``ScalarFormatter`` (même nombre de décimales pour toutes), écrites par :func:`format_number`, et
@@ -337,7 +354,12 @@ def french_figure(figure) -> None:
 def bokeh_tick_formatter(group_thousands: bool = True):
     """Un formateur de graduations Bokeh (``CustomJSTickFormatter``) : virgule décimale, signe moins
     typographique, puissances de dix :math:`\\times 10^{n}` (même rendu que :func:`format_number`).
-    ``group_thousands=False`` pour un axe d'années : « 1880 », jamais « 1 880 »."""
+    ``group_thousands=False`` pour un axe d'années : « 1880 », jamais « 1 880 ».
+
+    Une seule écriture par axe : dès qu'une graduation de l'axe s'écrit en puissance de dix
+    (:math:`|x| < 10^{-3}` ou :math:`|x| \\ge 10^{6}`), toutes les graduations non nulles de l'axe s'écrivent
+    ainsi, « 10ⁿ » quand la mantisse vaut 1 (comme les axes logarithmiques des figures matplotlib,
+    :func:`matplotlib_log_formatter`) : jamais « 100 000 » à côté de « 1 × 10⁶ »."""
     from bokeh.models import CustomJSTickFormatter
 
     code = r"""
@@ -350,11 +372,13 @@ def bokeh_tick_formatter(group_thousands: bool = True):
         const grouped = group ? int.replace(/\B(?=(\d{3})+(?!\d))/g, "\u202f") : int;
         return (neg ? "\u2212" : "") + grouped + (dec ? "," + dec : "");
     };
-    const a = Math.abs(tick);
-    if (a < 1e-3 || a >= 1e6) {
+    const scientific = (v) => v !== 0 && isFinite(v) && (Math.abs(v) < 1e-3 || Math.abs(v) >= 1e6);
+    const all = (typeof ticks !== "undefined" && ticks) ? Array.from(ticks) : [tick];
+    if (scientific(tick) || all.some(scientific)) {
         const [m, e] = tick.toExponential(2).split("e");
         const mantissa = String(parseFloat(m));
         const exp = String(parseInt(e, 10)).split("").map(c => sup[c]).join("");
+        if (mantissa === "1" || mantissa === "-1") { return (mantissa === "-1" ? "\u2212" : "") + "10" + exp; }
         return french(mantissa) + "\u202f×\u202f10" + exp;
     }
     return french(String(Number(tick.toPrecision(6))));

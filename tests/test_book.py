@@ -390,3 +390,102 @@ def test_errata_headings_have_no_math():
     """Un titre d'entrée sert de texte aux liens {ref} des chapitres, rendu sans MathJax : pas de $…$."""
     headings = re.findall(r"^### (.*)$", (BOOK / "errata.md").read_text(), re.M)
     assert headings and not [h for h in headings if "$" in h or "\\" in h]
+
+
+# --------------------------------------------------------------------------- relecture (issue 36), pages construites
+
+
+def _article_text(built_book: Path, page: str) -> str:
+    """Le texte de l'article d'une page construite, formules écrites en TeX entre « $ »."""
+    html = (built_book / "book" / f"{page}.html").read_text()
+    body = html.split('<article class="bd-article"', 1)[-1].split("</article>", 1)[0]
+    body = re.sub(r"<(script|style)\b.*?</\1>", "", body, flags=re.S)
+    body = re.sub(r'<mjx-container[^>]*data-kc-tex="([^"]*)"[^>]*>.*?</mjx-container>',
+                  lambda m: " $" + htmllib.unescape(m.group(1)) + "$ ", body, flags=re.S)
+    return " ".join(htmllib.unescape(re.sub(r"<[^>]+>", " ", body)).split())
+
+
+def _outputs(built_book: Path, page: str) -> str:
+    html = (built_book / "book" / f"{page}.html").read_text()
+    return "\n".join(htmllib.unescape(re.sub(r"<[^>]+>", "", b)) for b in _CELL_OUTPUT.findall(html))
+
+
+@pytest.mark.book
+def test_manoeuvring_targets_page_cites_the_centripetal_acceleration_and_a_cautious_imm(built_book):
+    """« 0,12 rad/s, soit 2,4 m/s² » (le changement de cap en radians) : la page cite vω = 6 et 4 m/s² (les
+    accélérations sont vérifiées sur la trajectoire simulée par tests/test_tracking_scenarios.py) ; l'IMM y
+    est « prudent », jugé pas à pas, et non « cohérent » par sa moyenne sur le vol."""
+    from kalman_course.scenarios import manoeuvre as man
+
+    text = _article_text(built_book, "cibles-manoeuvrantes")
+    assert "2,4 m/s²" not in text
+    assert re.search(r"accélération centripète vaut alors \$v\\omega =\$ 6 m/s²", text)
+    assert re.search(r"0,08 rad/s \( ?4 m/s²\)", text)
+    assert "$\\alpha^{-20}$" not in text and "divisé par $\\alpha^{20}$" in text
+    below, inside, above = man.manoeuvre_study().band_shares("IMM")
+    share = re.search(r"est \*?\*?prudent\W+sa NEES moyenne est dans l’intervalle à (\d+) % des pas seulement, en "
+                      r"dessous à (\d+) %", text.replace("**", ""))
+    assert share and (int(share[1]), int(share[2])) == (round(100 * inside), round(100 * below)), share
+    assert "seul l’IMM est à la fois précis partout et cohérent" not in text
+    assert "NEES moyen " not in text  # la NEES, au féminin
+
+
+@pytest.mark.book
+def test_filter_choice_text_cites_the_table_numbers(built_book):
+    """Le texte citait « 150 m » (deux chiffres) là où le tableau dit 145 : texte, tableau et lecture des
+    curseurs écrivent les mêmes nombres (trois chiffres significatifs)."""
+    text = _article_text(built_book, "quel-filtre")
+    cited = re.search(r"l’EKF finit avec une REQM de ([\d ,]+) m et une NEES moyenne de ([\d  ,]+) au lieu", text)
+    row = re.search(r"\bEKF ([\d ,]+) ([\d  ,]+) \d+ %", text)
+    assert cited and row and cited.groups() == row.groups(), (cited and cited.groups(), row and row.groups())
+    pf = re.search(r"filtre particulaire ([\d  ,]+) ∞", text)
+    assert pf and f"échoue ( {pf[1]} m)" in text
+
+
+@pytest.mark.book
+def test_gate_exercise_prints_plain_probabilities_and_french_plurals(built_book):
+    """« p = 0,90000 » et « 1 rejetées » : l'exercice des fenêtres écrit « p = 0,9 » et accorde le pluriel."""
+    out = _outputs(built_book, "capteurs-temps-irregulier")
+    assert "p = 0,9 : 240 positions rejetées" in out
+    assert "0,90000" not in out and "1 rejetées" not in out and "1 position rejetée" in out
+    text = _article_text(built_book, "capteurs-temps-irregulier")
+    assert "perdue puis retrouvée" not in text and "perdue pour de bon" in text
+    assert "si chaque NIS était indépendant" not in text
+
+
+@pytest.mark.book
+def test_outputs_have_no_space_inside_parentheses(built_book):
+    """« (exact : 0,800 ) » : aucune sortie de cellule n'a d'espace juste après « ( » ou avant « ) »."""
+    problems = []
+    for page in sorted((built_book / "book").glob("*.html")):
+        for m in re.finditer(r"\( \S|\S \)", _outputs(built_book, page.stem)):
+            problems.append(f"{page.name} : « {m.group(0)} »")
+    assert not problems, problems[:10]
+
+
+@pytest.mark.book
+def test_slider_fallback_paragraph_has_french_spacing(built_book):
+    """Le paragraphe de repli des figures à curseurs (HTML brut, hors de la passe de typographie) a son espace
+    insécable avant « : » sur toutes les pages."""
+    pages = 0
+    for page in sorted((built_book / "book").glob("*.html")):
+        for missing in re.findall(r'<p class="kc-bokeh-missing">(.*?)</p>', page.read_text(), re.S):
+            pages += 1
+            assert "précalculés\u00a0: elle" in missing and " :" not in missing, (page.name, missing[:80])
+    assert pages >= 20
+
+
+@pytest.mark.book
+def test_parallel_page_proves_associativity_and_names_dynamax_correctly(built_book):
+    """La démonstration de l'associativité est repliée (« Démonstration ») et cite la vérification par
+    quadrature ; dynamax : une fonction à part, le ticket 423 corrigé par la demande de fusion 455."""
+    html = (built_book / "book" / "filtrage-parallele.html").read_text()
+    proof = re.search(r'<div class="([^"]*\bproof\b[^"]*)"[^>]*>\s*<p class="admonition-title">Démonstration</p>'
+                      r'(.*?)</div>', html, re.S)
+    assert proof and "dropdown" in proof.group(1).split()
+    assert "Fubini" in proof.group(2) and "Tonelli" in proof.group(2)
+    text = _article_text(built_book, "filtrage-parallele")
+    assert "parallel_lgssm_filter" in text and "ticket n° 423" in text and "455" in text
+    assert "filtre par défaut" not in text and "question n° 423" not in text
+    spread = re.search(r"le rapport des deux varie de ([^ ]+ × 10⁻[⁰¹²³⁴⁵⁶⁷⁸⁹]+|0) en relatif", text)
+    assert spread, "vérification par quadrature non citée"

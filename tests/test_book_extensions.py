@@ -5,6 +5,7 @@ la main)."""
 from __future__ import annotations
 
 import inspect
+import re
 from pathlib import Path
 
 import pybtex.plugin
@@ -172,30 +173,60 @@ def test_a_formula_mathjax_refuses_names_its_page(tmp_path, mathjax_settings):
                         "td.html : « \\frac{1}{ » : Missing close brace"]
 
 
-def test_proofs_get_a_french_title_and_their_own_ids():
-    """sphinx-proof écrit ``{prf:proof}`` sans titre, « Proof. » en tête du texte et l'identifiant ``proof`` pour
-    toutes : l'extension des pages leur donne le titre « Démonstration » (que le script des encadrés
-    ``dropdown`` replie) et un identifiant par démonstration (issue 37)."""
-    from docutils import nodes
-    from docutils.frontend import get_default_settings
-    from docutils.parsers.rst import Parser
-    from docutils.utils import new_document
+# --------------------------------------------------------------------------- sphinx-proof en français (issue 36)
 
-    from kalman_course.sphinx.pages import PROOF_TITLE, french_proof
+_PROOF_PAGE = """# Chapitre
 
-    document = new_document("chapitre", get_default_settings(Parser))
-    for _ in range(2):
-        proof = nodes.admonition(classes=["proof", "proof", "dropdown"], ids=["proof"])
-        proof += nodes.paragraph("", "", nodes.Text("Proof. Sachant "), nodes.emphasis("", "θ"))
-        document += proof
-        document.ids["proof"] = proof
-    proofs = list(document.findall(nodes.admonition))
-    for proof in proofs:
-        french_proof(proof, document)
-    assert [p[0].astext() for p in proofs] == [PROOF_TITLE] * 2 and isinstance(proofs[0][0], nodes.title)
-    assert [p[1].astext() for p in proofs] == ["Sachant θ"] * 2
-    ids = [p["ids"] for p in proofs]
-    assert len(ids[0]) == len(ids[1]) == 1 and ids[0] != ids[1] and "proof" not in document.ids
-    french_proof(proofs[0], document)  # une seconde fois : rien ne change
-    assert proofs[0][0].astext() == PROOF_TITLE and len(proofs[0]) == 2
+```{prf:algorithm} Un pas du filtre
+:label: alg-pas
 
+1. Prédire.
+2. Corriger.
+```
+
+```{prf:proof}
+:class: dropdown
+
+Par **Fubini**, les deux intégrales sont égales.
+```
+"""
+
+
+def _sphinx_project(tmp_path: Path, builder: str) -> tuple[int, Path, str]:
+    import contextlib
+    import io
+
+    from sphinx.cmd.build import build_main
+
+    src = tmp_path / f"src-{builder}"
+    src.mkdir()
+    (src / "conf.py").write_text('extensions = ["myst_parser", "sphinx_proof", "kalman_course.sphinx.proofs"]\n'
+                                 'myst_enable_extensions = ["colon_fence", "dollarmath"]\nlanguage = "fr"\n'
+                                 'root_doc = "index"\nnumfig = True\n')
+    (src / "index.md").write_text(_PROOF_PAGE)
+    out, log = tmp_path / f"out-{builder}", io.StringIO()
+    with contextlib.redirect_stderr(log):
+        code = build_main(["-b", builder, "-q", "-W", "-E", str(src), str(out)])
+    return code, out, log.getvalue()
+
+
+def test_proofs_get_a_french_title_and_fold(tmp_path):
+    """« Proof. » (sphinx-proof) devient un encadré titré « Démonstration », replié avec ``:class: dropdown``
+    (le titre sert de bouton à sphinx-togglebutton)."""
+    code, out, log = _sphinx_project(tmp_path, "html")
+    assert code == 0, log
+    html = (out / "index.html").read_text()
+    assert "Proof." not in html
+    box = re.search(r'<div class="([^"]*)" id="([^"]+)">\s*<p class="admonition-title">Démonstration</p>', html)
+    assert box and {"proof", "dropdown", "admonition"} <= set(box.group(1).split()), html
+    assert box.group(2) != "proof"  # un identifiant par encadré (sphinx-proof donnait « proof » à toutes)
+    assert "Par <strong>Fubini</strong>, les deux" in html
+
+
+def test_algorithm_boxes_are_titled_in_french_in_the_pdf(tmp_path):
+    """Dans le LaTeX (le PDF), les encadrés d'algorithme sont titrés « Algorithme », comme sur le site."""
+    code, out, log = _sphinx_project(tmp_path, "latex")
+    assert code == 0, log
+    tex = next(out.glob("*.tex")).read_text()
+    assert "Algorithm " not in tex.replace("\\begin{algorithm", "") and "Algorithme" in tex
+    assert "Proof." not in tex and "Démonstration" in tex

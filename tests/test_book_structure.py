@@ -32,7 +32,7 @@ CHAPTERS = [p for p in TOC if p not in APPENDICES and p != TOC[0]]
 #: les encadrés « Objectifs » et « Prérequis » (les chapitres à avoir lus) et finissent par un quiz ; elles
 #: n'ont ni section « À retenir » (un encadré la remplace, après le quiz), ni « La suite », ni bibliographie :
 #: le cours qu'elles exercent est dans les chapitres cités en prérequis.
-PRACTICE = [p for p in CHAPTERS if re.match(r"t[dp]-", p)]
+PRACTICE = [p for p in CHAPTERS if re.match(r"t[dp]-|sujet-examen$", p)]
 LESSONS = [p for p in CHAPTERS if p not in PRACTICE]
 
 
@@ -172,8 +172,8 @@ def test_practice_furniture_check_flags_missing_boxes_and_quiz():
 
 
 def test_practice_pages_are_the_td_and_tp_pages():
-    assert PRACTICE and all(p.startswith(("td-", "tp-")) for p in PRACTICE)
-    assert len(LESSONS) >= 20 and not any(p.startswith(("td-", "tp-")) for p in LESSONS)
+    assert PRACTICE and all(p.startswith(("td-", "tp-", "sujet-examen")) for p in PRACTICE)
+    assert len(LESSONS) >= 20 and not any(p.startswith(("td-", "tp-", "sujet-")) for p in LESSONS)
 
 
 @pytest.mark.parametrize("page", PRACTICE)
@@ -253,6 +253,15 @@ WORDING = {
     r"\bobservateurs?\b(?! est un estimateur)(?!\s*»)": "« fonction d'observation » (un observateur est un estimateur)",
     r"\ble NIS\b": "« la NIS » (l'innovation normalisée)",
     r"regroupant les carrés": "« en complétant le carré »",
+    # relecture (issue 36) : un terme par notion, moins de personnification
+    r"\b(?:le|un|son|du|au|ce) NEES\b|\bNEES moyen\b": "« la NEES » (une erreur normalisée, comme « la NIS »)",
+    r"(?<!racine de l['’])\berreur quadratique moyenne\b":
+        "« racine de l'erreur quadratique moyenne (REQM) » (la valeur citée est une REQM)",
+    r"\b(?:la|une|sa|sans|cette|leur|propre|à|de) portes?\b(?!\s+(?:sur|le|la|les|l['’]|un|une|des|son|sa|ses|"
+    r"leur|aussi|bien|tout|toute|donc|alors|souvent)\b)": "« fenêtre de validation » (en anglais *gate*)",
+    r"\bse croi(?:t|ent)\b|\btrembl(?:e|ent|er)\b":
+        "ce que font l'estimation ou sa covariance (« suit le bruit des mesures », « sa covariance sous-estime "
+        "l'erreur »)",
 }
 
 
@@ -275,7 +284,9 @@ def test_wording_of_the_course(page):
     assert not problems, f"{page} : " + " ; ".join(problems)
 
 
-_SOFTWARE = re.compile(r"\b[Ll]es tests (?:du paquet )?(?:l[ea] |les |l['’])?(?:vérifient|comparent)|`test_\w+`")
+# (une phrase coupée en fin de ligne compte aussi ; un script de mesure nommé dans la prose aussi : issue 36)
+_SOFTWARE = re.compile(r"\b[Ll]es\s+tests\s+(?:du\s+paquet\s+)?(?:l[ea]\s+|les\s+|l['’])?(?:vérifient|comparent)"
+                       r"|`test_\w+`|`benchmarks/[\w./]+`")
 
 
 def software_talk_outside_boxes(text: str) -> list[str]:
@@ -289,6 +300,9 @@ def test_software_talk_check():
         == ["`test_joseph`", "Les tests vérifient"]
     assert software_talk_outside_boxes("C'est le même calcul. Les tests du paquet le vérifient.") == [
         "Les tests du paquet le vérifient"]
+    assert software_talk_outside_boxes("C'est un point fixe (les tests du\npaquet le vérifient), mesuré par "
+                                       "`benchmarks/imm.py`.") == ["les tests du\npaquet le vérifient",
+                                                                   "`benchmarks/imm.py`"]
     boxed = ":::{admonition} Dans le paquet\n:class: seealso\nLe test `test_joseph` la compare.\n:::\n"
     assert software_talk_outside_boxes("La covariance est juste.\n\n" + boxed) == []
 
@@ -549,3 +563,131 @@ def test_errata_entries_say_what_checks_them_in_words_then_name_the_test():
     assert len(entries) >= 70
     problems = [f"{entry.split(chr(10), 2)[1][:40]} : {p}" for entry in entries for p in verified_by_problems(entry)]
     assert not problems, "\n".join(problems)
+
+
+# --------------------------------------------------------------------------- relecture (issue 36)
+
+_CELL = re.compile(r"^```\{code-cell\}[^\n]*\n(.*?)^```", re.S | re.M)
+
+
+def _cells(text: str) -> list[tuple[bool, str]]:
+    """Les cellules de code d'une page MyST : ``(cachée, code)`` (``remove-cell`` ou ``remove-input``)."""
+    out = []
+    for cell in _CELL.findall(text):
+        tags = re.search(r"^:tags:\s*\[([^\]]*)\]", cell, re.M)
+        hidden = bool(tags and {"remove-cell", "remove-input"} & {t.strip() for t in tags.group(1).split(",")})
+        body = re.sub(r"\A---\n.*?\n---\n", "", cell, flags=re.S)
+        out.append((hidden, "\n".join(line for line in body.splitlines() if not line.startswith(":tags:"))))
+    return out
+
+
+def hidden_definitions_used_in_visible_cells(text: str) -> list[str]:
+    """Les noms qu'une cellule **cachée** définit (fonction, classe, variable ; pas une importation, que la
+    page montre dans « Importations du chapitre ») et qu'une cellule **visible** emploie sans les définir :
+    l'étudiant qui recopie les cellules visibles obtiendrait une ``NameError``."""
+    import ast
+
+    def names(tree, kinds):
+        out = set()
+        for node in ast.walk(tree):
+            if "def" in kinds and isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+                out.add(node.name)
+            elif "def" in kinds and isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+                out.add(node.id)
+            elif "import" in kinds and isinstance(node, (ast.Import, ast.ImportFrom)):
+                out |= {(a.asname or a.name).split(".")[0] for a in node.names}
+        return out
+
+    hidden_defs, visible_defs, problems = set(), set(), []
+    for hidden, code in _cells(text):
+        try:
+            tree = ast.parse(code)
+        except SyntaxError:  # une cellule magique d'IPython : rien à lire
+            continue
+        if hidden:
+            hidden_defs |= names(tree, {"def"}) - names(tree, {"import"})
+            continue
+        own = names(tree, {"def", "import"})
+        loads = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+        problems += sorted((loads & hidden_defs) - visible_defs - own - set(problems))
+        visible_defs |= own
+    return problems
+
+
+def test_hidden_definition_check():
+    hidden = "```{code-cell} ipython3\n:tags: [remove-cell]\nimport numpy as np\n\ndef exact(v):\n    return v\n```\n"
+    bad = hidden + "\n```{code-cell} ipython3\nprint(exact(np.ones(2)))\n```\n"
+    assert hidden_definitions_used_in_visible_cells(bad) == ["exact"]
+    good = hidden + "\n```{code-cell} ipython3\ndef exact(v):\n    return 2 * v\nprint(exact(np.ones(2)))\n```\n"
+    assert hidden_definitions_used_in_visible_cells(good) == []
+
+
+@pytest.mark.parametrize("page", TOC)
+def test_visible_cells_run_when_copied(page):
+    """td-lissage-em appelait ``exact()``, définie dans une cellule cachée : les cellules visibles n'emploient
+    que des noms qu'elles définissent ou que la page importe (bloc « Importations du chapitre »)."""
+    problems = hidden_definitions_used_in_visible_cells(_text(page))
+    assert not problems, f"{page} : noms définis dans une cellule cachée : {problems}"
+
+
+@pytest.mark.parametrize("chapter", LESSONS)
+def test_the_bridge_names_the_next_page(chapter):
+    """« La suite » renvoie à la page qui suit dans la table des matières (enkf sautait « Un seul filtre
+    gaussien » et « Quel filtre choisir ? », écrits après lui) : un chapitre inséré met à jour le précédent."""
+    keep = _text(chapter).split("## À retenir", 1)[1].split("\n## ", 1)[0]
+    bridge = re.search(r"^\*\*La suite\.\*\* (.+)$", keep, re.M)
+    cited = re.findall(r"\{doc\}`(?:[^`<]*<)?([\w-]+)>?`", bridge.group(1)) if bridge else []
+    following = TOC[TOC.index(chapter) + 1]
+    assert following in cited, f"{chapter} : « La suite » ne cite pas {following} (cite {cited})"
+
+
+def test_the_gaussian_chapter_names_the_chapters_it_builds_on():
+    """« Les deux chapitres précédents » (l'EKF et l'UKF) était faux depuis que le filtre particulaire et l'EnKF
+    les séparent de « Un seul filtre gaussien » : le chapitre les nomme."""
+    text = _text("filtre-gaussien")
+    assert "chapitres précédents" not in text
+    assert re.search(r"Les chapitres \{doc\}`ekf`\s+et \{doc\}`ukf`", text)
+
+
+def test_glossary_has_the_notions_of_the_newest_chapters():
+    """Les notions des chapitres de pistage, du filtre gaussien, du choix d'un filtre et du filtrage parallèle,
+    avec leur nom anglais (chercher « gating » sur le site trouve le glossaire)."""
+    rows = {re.sub(r"[*«»]", "", r.split("|")[1]).strip().lower(): r.split("|")[2].lower()
+            for r in _text("glossaire").splitlines() if r.startswith("| ") and not r.startswith("| terme")}
+    for term, english in (("imm", "interacting multiple model"), ("régime, mode", "mode"),
+                          ("fenêtre de validation", "gating"), ("mémoire évanescente", "fading memory"),
+                          ("ajustement de covariance", "covariance matching"), ("cohérence", "consistency"),
+                          ("filtre gaussien", "gaussian filter"), ("cubature", "cubature"),
+                          ("gauss–hermite", "gauss–hermite"), ("iplf", "posterior linearisation"),
+                          ("produit préfixe", "prefix"), ("piste", "track")):
+        hits = [k for k in rows if k.startswith(term)]
+        assert hits and english in rows[hits[0]], term
+
+
+def test_bibliography_notes_use_the_words_of_the_course():
+    """Les notes de ``references.bib`` (imprimées dans les bibliographies) suivent le vocabulaire du cours :
+    la note de Durbin et Koopman disait encore « départ diffus exact »."""
+    notes = re.findall(r"^\s*note\s*=\s*\{(.*)\},?\s*$", (BOOK / "references.bib").read_text(), re.M)
+    assert len(notes) >= 10
+    problems = [p for note in notes for p in wording_problems(note)]
+    assert not problems, problems
+
+
+def test_readme_speaks_to_lecturers_on_one_screen_and_contributing_holds_the_machinery():
+    """Le README tient sur un écran (ce qu'est le cours, les deux commandes, publier, les TP) ; la CI lance
+    la commande de test qu'il donne ; le détail des tests (sessions, caches, CI) est dans CONTRIBUTING.md."""
+    readme = (ROOT / "README.md").read_text()
+    assert len(readme.splitlines()) <= 50
+    sections = re.findall(r"^## (.+)$", readme, re.M)
+    assert sections[:3] == ["Les deux commandes", "Publier", "Travaux pratiques"], sections
+    commands = re.findall(r"^bash (scripts/\S+)", readme, re.M)
+    assert commands == ["scripts/build.sh", "scripts/test.sh"]
+    assert "bash scripts/test.sh || status=$?" in (ROOT / ".ci" / "run").read_text()
+    assert "bash scripts/lab.sh" in readme and "CONTRIBUTING.md" in readme
+    for detail in ("KALMAN_GRID_CACHE", "cache d'exécution", "fmtutil.cnf"):  # la machinerie des tests
+        assert detail not in readme, detail
+    contributing = (ROOT / "CONTRIBUTING.md").read_text()
+    for heading in ("## Écrire un chapitre : ce que vérifient les tests", "## Organisation",
+                    "## Publier le livre : boutons de lancement"):
+        assert heading in contributing, heading
+    assert "KALMAN_GRID_CACHE" in contributing and "`.ci/run`" in contributing

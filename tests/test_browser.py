@@ -727,6 +727,21 @@ def _check_chapter_sliders(site: Site, html_file: Path, visit: Visit, problems: 
         problems.append(f"{html_file.relative_to(site.root).as_posix()} : aucune figure à curseurs")
 
 
+#: Contraste WCAG entre la couleur du texte d'un élément et son fond (calculés par le navigateur).
+_CONTRAST = r"""(el) => {
+  const rgb = (c) => (c.match(/[\d.]+/g) || []).slice(0, 4).map(Number);
+  const lum = ([r, g, b]) => {
+    const f = (v) => { v /= 255; return v <= 0.03928 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4); };
+    return 0.2126 * f(r) + 0.7152 * f(g) + 0.0722 * f(b);
+  };
+  const style = getComputedStyle(el);
+  let bg = rgb(style.backgroundColor);
+  for (let p = el.parentElement; p && (bg.length === 4 && bg[3] === 0); p = p.parentElement) bg = rgb(getComputedStyle(p).backgroundColor);
+  const a = lum(rgb(style.color)), b = lum(bg);
+  return (Math.max(a, b) + 0.05) / (Math.min(a, b) + 0.05);
+}"""
+
+
 def _check_quiz(site: Site, html_file: Path, visit: Visit, problems: list[str], report: list[str]) -> None:
     """Chaque question du quiz de la page : une mauvaise réponse est marquée fausse, la bonne juste,
     l'explication se déplie ; aucune requête pendant le quiz."""
@@ -752,9 +767,22 @@ def _check_quiz(site: Site, html_file: Path, visit: Visit, problems: list[str], 
             question.locator(".kc-quiz-check").click()
             return question.get_attribute("class").split(), question.locator(".kc-quiz-feedback").text_content()
 
-        classes, feedback = submit(1 if answer != 1 else 2)
+        wrong = 1 if answer != 1 else 2
+        classes, feedback = submit(wrong)
         if "kc-quiz-wrong" not in classes or not feedback.startswith("Pas tout"):
             problems.append(f"{name} : question {q + 1}, une mauvaise réponse n'est pas marquée fausse")
+        # le message de la mauvaise réponse choisie, et lui seul, est montré (issue 36)
+        shown = question.locator(".kc-quiz-why").evaluate_all(
+            "ws => ws.filter(w => !w.hidden && w.offsetParent !== null).map(w => w.dataset.choice)")
+        if shown != [str(wrong)]:
+            problems.append(f"{name} : question {q + 1}, messages montrés {shown} pour la réponse {wrong}")
+        if q == 0:  # « Vérifier » reste lisible au survol (fond et texte de la même couleur auparavant)
+            button = question.locator(".kc-quiz-check")
+            button.hover()
+            ratio = page.evaluate(_CONTRAST, button.element_handle())
+            if ratio < 4.5:
+                problems.append(f"{name} : « Vérifier » au survol, contraste {ratio:.2f} < 4,5")
+            page.mouse.move(0, 0)
         classes, feedback = submit(answer)
         if "kc-quiz-right" not in classes or not feedback.startswith("Juste"):
             problems.append(f"{name} : question {q + 1}, la bonne réponse n'est pas marquée juste")
@@ -985,7 +1013,8 @@ _PHONE = r"""() => {
                cut: [], values: []};
   const column = document.querySelector('main .bd-article, main article, main');
   const width = column ? column.getBoundingClientRect().width : window.innerWidth;
-  for (const el of document.querySelectorAll('main .kc-bokeh-panel, main .kc-bokeh-slider, main img, main object')) {
+  // (le canevas de Bokeh aussi : un plan de largeur fixe dépassait de sa boîte, coupé par la colonne)
+  for (const el of document.querySelectorAll('main .kc-bokeh-panel, main .kc-bokeh-canvas > *, main .kc-bokeh-slider, main img, main object')) {
     const b = el.getBoundingClientRect();
     if (b.width > 0 && (b.right > window.innerWidth + 1 || b.left < -1)) out.wide.push(el.id || el.tagName);
   }
@@ -1208,6 +1237,11 @@ def test_diagrams_and_quiz_answers_have_text_alternatives(site, browser):
                           "r.getAttribute('aria-label'))")
     assert names and all(re.fullmatch(r"Réponse [a-e] : .+", n) for n in names), names
     assert not any("\\" in n or "{" in n for n in names), names  # pas de TeX brut
+    # « Vérifier » au survol, en mode clair (issue 36 : fond et texte rgb(34, 40, 50))
+    button = page.locator(".kc-quiz-check").first
+    button.scroll_into_view_if_needed()
+    button.hover()
+    assert page.evaluate(_CONTRAST, button.element_handle()) >= 4.5
     page.context.close()
 
 
@@ -1229,3 +1263,49 @@ def test_search_shows_readable_snippets(site, browser):
         assert not re.search(r"\\\(|\\\)|\\\[|\\[a-zA-Z]{2,}", r["text"]), r["text"][:200]
     assert not page_errors(visit, "")
     page.context.close()
+
+
+def _search(site, browser, query: str) -> tuple[Visit, list[dict]]:
+    visit = open_page(browser, site.base + f"search.html?q={query}", site.base, figures=False)
+    page = visit.page
+    page.wait_for_function("() => document.querySelector('#search-results .search-summary, #search-results p')",
+                           timeout=30000)
+    page.wait_for_timeout(1500)  # les extraits arrivent page par page
+    results = page.evaluate("""() => [...document.querySelectorAll('#search-results li')].map(li => ({
+        href: li.querySelector('a').getAttribute('href'), text: li.textContent}))""")
+    return visit, results
+
+
+def test_search_speaks_french_and_reads_the_article_only(site, browser):
+    """La recherche (issue 36) : le champ dit « Rechercher dans le livre… » et sa loupe ne couvre pas le texte
+    tapé ; l'index ne contient pas le TeX des formules (« aligned » ne trouve rien) ; « gating » trouve le
+    glossaire ; les extraits ne montrent ni le TeX d'un environnement (« && ») ni la table des matières de la
+    page, ni ses importations."""
+    visit, results = _search(site, browser, "gauss")
+    page = visit.page
+    field = page.locator("form.bd-search input[type=search]").first
+    assert field.get_attribute("placeholder") == "Rechercher dans le livre…"
+    gap = page.evaluate("""() => {
+        const form = document.querySelector('.bd-search-container form.bd-search') ||
+                     document.querySelector('form.bd-search');
+        const icon = form.querySelector('.fa-magnifying-glass').getBoundingClientRect();
+        const input = form.querySelector('input');
+        const start = input.getBoundingClientRect().left + parseFloat(getComputedStyle(input).paddingLeft);
+        return start - icon.right;
+    }""")
+    assert gap >= 0, f"la loupe recouvre le texte du champ de {-gap:.1f} px"
+    gaussian = [r for r in results if "filtre-gaussien" in r["href"]]
+    assert gaussian, [r["href"] for r in results]
+    for r in results:
+        assert "&&" not in r["text"] and "aligned" not in r["text"], r["text"][:200]
+        assert "Importations du chapitre" not in r["text"], r["text"][:200]
+    # la table des matières de la page : ses titres de sections, à la suite
+    assert "Quatre règles pour trois intégrales La banane" not in " ".join(gaussian[0]["text"].split())
+    close_visit(visit, None)
+    visit, results = _search(site, browser, "aligned")
+    assert results == [], [r["href"] for r in results]
+    close_visit(visit, None)
+    visit, results = _search(site, browser, "gating")
+    assert any("glossaire" in r["href"] for r in results), [r["href"] for r in results]
+    assert any("capteurs-temps-irregulier" in r["href"] for r in results), [r["href"] for r in results]
+    close_visit(visit, None)

@@ -23,7 +23,8 @@ APPENDICES = {"references", "errata", "glossaire"}
 #: Travaux dirigés (papier et crayon) et travaux pratiques (l'étudiant écrit le code, le correcteur
 #: répond) : pas de figure à curseurs — l'interactivité d'un TD est le calcul à la main, celle d'un TP le
 #: code de l'étudiant et le verdict de practice.check. Objectifs, « À retenir » et quiz restent exigés.
-PRACTICE_PAGES = {p.stem for p in (Path(__file__).resolve().parent.parent / "book").glob("t[dp]-*.md")}
+PRACTICE_PAGES = {p.stem for p in (Path(__file__).resolve().parent.parent / "book").glob("t[dp]-*.md")} | {
+    "sujet-examen"}  # le sujet d'examen : une page d'exercices, comme un TD
 
 
 def _pages() -> list[str]:
@@ -44,25 +45,12 @@ def _h2(text: str) -> list[str]:
 
 
 def quiz_questions(text: str) -> list[dict]:
-    """Les questions du quiz d'une page : énoncé, réponses proposées, numéro de la bonne, nom, explication."""
-    blocks = re.findall(r"^::::\{quiz\}[^\n]*\n(.*?)^::::\s*$", text, re.M | re.S)
-    out = []
-    for block in blocks:
-        for body in re.findall(r"^:::\{question\}\n(.*?)^:::\s*$", block, re.M | re.S):
-            options = dict(re.findall(r"^:(\w+): *(.*)$", body, re.M))
-            lines = [ln for ln in body.splitlines() if not re.match(r"^:\w+:", ln)]
-            first = next(i for i, ln in enumerate(lines) if ln.startswith("- "))
-            last = first
-            while last + 1 < len(lines) and lines[last + 1].startswith("- "):
-                last += 1
-            out.append({
-                "answer": int(options["answer"]),
-                "name": options.get("name", ""),
-                "statement": "\n".join(lines[:first]).strip(),
-                "choices": [ln[2:].strip() for ln in lines[first:last + 1]],
-                "why": "\n".join(lines[last + 1:]).strip(),
-            })
-    return out
+    """Les questions du quiz d'une page : énoncé, réponses proposées, numéro de la bonne, nom, explication
+    (la lecture de :func:`kalman_course.sphinx.quiz.quiz_questions`, celle de la directive)."""
+    from kalman_course.sphinx.quiz import quiz_questions as read
+
+    return [{"answer": q.answer, "name": q.name, "statement": q.statement, "choices": q.choices,
+             "why": q.explanation, "messages": q.messages} for q in read(text)]
 
 
 def french_number(text: str) -> float:

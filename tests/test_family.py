@@ -455,3 +455,46 @@ def test_engine_random_generator_and_step_outputs_hooks():
         run_filter(family, model, y, [0.0], [[1.0]])
     with pytest.raises(kc.KalmanInputError, match="« rng » est fourni, mais le filtre de Kalman ne tire rien"):
         run_filter(kc.filters.kalman.kalman_family(), model, y, [0.0], [[1.0]], rng=1)
+
+
+# --------------------------------------------------------------------------- filtres sur SE(2) (issue 35)
+# L'EKF invariant et l'EKF standard du robot plan ne se réduisent pas au filtre de Kalman (l'état est une pose) :
+# ils rejoignent la famille par le moteur — mêmes pas sans mesure, mêmes erreurs sur y et u, lot = tirage par
+# tirage. Leurs équations sont vérifiées dans tests/test_invariant.py.
+
+SE2_MEMBERS = [kc.se2_invariant_ekf, kc.se2_standard_ekf]
+
+
+def _se2_case(T=40):
+    rng = np.random.default_rng(35)
+    model = kc.OdometryGnssModel(0.05, [0.02, 0.01, 0.03], 0.8)
+    u = np.array([1.0, 0.0, 0.3]) + 0.02 * rng.standard_normal((T, 3))
+    y = rng.standard_normal((T, 2))
+    T0 = kc.se2_exp([0.0, 0.0, 0.4])
+    return model, y, T0, np.diag([0.1, 0.1, 0.2]), u
+
+
+@pytest.mark.parametrize("member", SE2_MEMBERS, ids=lambda f: f.__name__)
+def test_se2_filters_missing_rows_are_prediction_only(member):
+    model, y, T0, P0, u = _se2_case()
+    y[[0, 7, 8, 30]] = np.nan
+    res = member(model, y, T0, P0, u)
+    for k in (0, 7, 8, 30):
+        np.testing.assert_array_equal(res.x[k], res.x_pred[k])
+        assert not res.observed[k].any() and np.all(res.K[k] == 0) and np.isnan(res.innovation[k]).all()
+    assert res.n_iter.tolist() == [0 if k in (0, 7, 8, 30) else 1 for k in range(len(y))]
+    runs = (kc.se2_invariant_ekf_runs if member is kc.se2_invariant_ekf else kc.se2_standard_ekf_runs)(
+        model, y[None], T0, P0, u)
+    np.testing.assert_allclose(runs.run(0).x, res.x, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("member", SE2_MEMBERS, ids=lambda f: f.__name__)
+@pytest.mark.parametrize("bad, message", BAD_INPUTS[:3] + BAD_INPUTS[7:])
+def test_se2_filters_share_the_engine_errors(member, bad, message):
+    model, y, T0, P0, u = _se2_case(T=5)
+    args = dict(y=y, u=u)
+    args.update(bad)
+    if "u" in bad:
+        args["u"] = np.zeros((4, 3))
+    with pytest.raises(kc.KalmanInputError, match=message):
+        member(model, args["y"], T0, P0, args["u"])

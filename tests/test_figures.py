@@ -413,3 +413,31 @@ def test_cli_chapter_groups_keep_each_figure_once_with_its_chapter():
     for group in groups:
         assert len({kc.figures.REGISTRY[n].chapter for n in group}) == 1
     assert [len(g) for g in groups] == sorted((len(g) for g in groups), reverse=True)
+
+
+# --------------------------------------------------------------------------- relecture (issue 36)
+
+
+def _overlapping_texts(fig) -> list[tuple[str, str]]:
+    """Les paires d'annotations d'un même axe (``ax.texts`` : repères, étiquettes posées sur le tracé) dont
+    les cadres se chevauchent une fois la figure dessinée."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    found = []
+    for ax in fig.axes:
+        boxes = [(t.get_text(), t.get_window_extent(renderer)) for t in ax.texts if t.get_visible() and t.get_text()]
+        for i, (a, ba) in enumerate(boxes):
+            for b, bb in boxes[i + 1:]:
+                if ba.overlaps(bb):
+                    found.append((a, b))
+    return found
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_annotations_of_a_figure_do_not_overlap(name):
+    """Sur la carte de l'hélicoptère, « 1 min » et « 4 min » (aller et retour au même endroit) étaient
+    écrits l'un sur l'autre : aucune figure n'a deux annotations qui se chevauchent."""
+    assert not _overlapping_texts(drawn(name)), name

@@ -153,3 +153,15 @@ def test_parallel_agreement_of_the_chapter():
     assert agreement.loglik_gap < 1e-8 * abs(agreement.loglik)
     timings = parallel.measured_timings()
     assert timings.T.shape == timings.speedup.shape and timings.date and timings.machine
+
+
+# --------------------------------------------------------------------------- relecture (issue 36)
+
+
+def test_measured_costs_of_81_and_8_points_are_close_as_the_chapter_explains():
+    """« Un pas du GHKF à 81 points coûte … fois un pas de l'EKF, et le CKF à 8 points … fois : presque
+    autant » (filtre-gaussien) : dans la mesure datée que cite le livre, les deux coûts diffèrent de moins de
+    20 %, et les deux filtres coûtent plus d'un EKF."""
+    costs, _ = filter_choice.measured_costs()
+    assert 1.0 < costs["CKF"] / costs["EKF"] and 1.0 < costs["GHKF"] / costs["EKF"]
+    assert abs(costs["GHKF"] / costs["CKF"] - 1.0) < 0.2

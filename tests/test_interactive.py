@@ -224,6 +224,9 @@ def test_static_figure_tells_jupyter_users_where_the_live_sliders_are():
     html = ki.voltage_sliders(n_steps=10)._repr_html_()
     assert "kc.interactive.live_voltage_explorer()" in html
     assert 'class="kc-bokeh-missing"' in html
+    # HTML brut, que l'extension de typographie ne voit pas : espace insécable avant « : » (issue 36)
+    missing = html.split('class="kc-bokeh-missing">', 1)[1].split("</p>", 1)[0]
+    assert "précalculés\u00a0: elle" in missing and " :" not in missing.replace("\u00a0:", "")
 
 
 # --------------------------------------------------------------------------- curseurs interactifs (ipywidgets)

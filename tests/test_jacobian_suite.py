@@ -1,6 +1,6 @@
 """Une seule suite qui vérifie par perturbation **toutes** les jacobiennes analytiques du paquet (comme manif
-le fait pour tous ses groupes) : modèles des scénarios, caméra, jacobiennes de SO(3)/SE(3), adjointe,
-prédiction sur SE(3).
+le fait pour tous ses groupes) : modèles des scénarios, caméra, jacobiennes de SO(3)/SE(3)/SE(2), adjointes,
+prédiction sur SE(3), prédictions de l'EKF invariant et de l'EKF standard sur SE(2).
 
 La référence est indépendante du code testé : différences centrées écrites ici, et, pour les groupes,
 l'exponentielle et le logarithme de matrices de scipy (``expm``, ``logm``) appliqués à des matrices
@@ -19,6 +19,7 @@ import kalman_course as kc
 from kalman_course.scenarios.polar import polar_to_cartesian, polar_to_cartesian_jacobian
 from kalman_course.geometry import camera as cam
 from kalman_course.geometry import lie
+from kalman_course.filters import invariant as inv
 from kalman_course.scenarios import radar, tag
 
 H = 1e-6  # pas des différences centrées
@@ -140,6 +141,92 @@ CASES += [
     Case("SE(3) prédiction : G = J_r(u)", lie.se3_right_jacobian,
          lambda u, d: Log6(np.linalg.inv(Exp6(u)) @ Exp6(u + d)), U_INCR, 1e-7),
 ]
+
+
+# --------------------------------------------------------------------------- SE(2) et filtrage invariant (issue 35)
+
+
+def hat_se2(xi):  # xi = [rho_x, rho_y, theta]
+    return np.array([[0.0, -xi[2], xi[0]], [xi[2], 0.0, xi[1]], [0.0, 0.0, 0.0]])
+
+
+def Exp3s(xi):
+    return scipy.linalg.expm(hat_se2(xi))
+
+
+def Log3s(T):
+    X = np.real(scipy.linalg.logm(T))
+    return np.array([X[0, 2], X[1, 2], X[1, 0]])
+
+
+XI2 = [RNG.normal(size=3) * s for s in (0.3, 1.0, 2.0)] + [np.array([0.4, -0.3, 1e-5]), np.array([2.0, 1.0, 0.04])]
+POSES2 = [Exp3s(x) for x in XI2]
+_odo = kc.OdometryGnssModel(0.05, [0.01, 0.02, 0.02], 1.0)
+U_ODO = [np.array([1.2, 0.1, 0.3]), np.array([0.8, -0.2, -2.0]), np.array([2.0, 0.0, 0.0])]
+POSE_ODO = Exp3s(np.array([1.0, -2.0, 2.5]))
+
+
+def _increment(u):
+    """U = [[Exp(ω dt), v dt], [0, 1]], écrit ici."""
+    a = u[2] * _odo.dt
+    return np.array([[np.cos(a), -np.sin(a), u[0] * _odo.dt], [np.sin(a), np.cos(a), u[1] * _odo.dt], [0, 0, 1.0]])
+
+
+def _pose_state(T):
+    return np.array([T[0, 2], T[1, 2], np.arctan2(T[1, 0], T[0, 0])])
+
+
+def _state_pose(x):
+    c, s = np.cos(x[2]), np.sin(x[2])
+    return np.array([[c, -s, x[0]], [s, c, x[1]], [0, 0, 1.0]])
+
+
+def _jac(kind, which, point):
+    F, G = inv.se2_prediction_jacobians(_odo, POSE_ODO, point, kind)
+    return F if which == "F" else G
+
+
+CASES += [
+    Case("SE(2) : J_r", lie.se2_right_jacobian, lambda x, d: Log3s(np.linalg.inv(Exp3s(x)) @ Exp3s(x + d)), XI2, 1e-7),
+    Case("SE(2) : J_l", lie.se2_left_jacobian, lambda x, d: Log3s(Exp3s(x + d) @ np.linalg.inv(Exp3s(x))), XI2, 1e-7),
+    Case("SE(2) : Ad_T (T Exp(δ) T⁻¹ = Exp(Ad_T δ))", lie.se2_adjoint,
+         lambda T, d: Log3s(T @ Exp3s(d) @ np.linalg.inv(T)), POSES2, 1e-7),
+    # EKF invariant : T̂ Exp(ξ) U(u + w) = T̂ U(u) Exp(ξ'), ξ' ≈ F ξ + G w
+    Case("SE(2) EKF invariant : F = Ad(U⁻¹)", lambda u: _jac("invariant", "F", u),
+         lambda u, d: Log3s(np.linalg.inv(_increment(u)) @ Exp3s(d) @ _increment(u)), U_ODO, 1e-7),
+    Case("SE(2) EKF invariant : G = dt diag(Exp(ω dt)ᵀ, 1)", lambda u: _jac("invariant", "G", u),
+         lambda u, d: Log3s(np.linalg.inv(_increment(u)) @ _increment(u + d)), U_ODO, 1e-7),
+    # EKF standard : x' = f(x, u + w), x = [p; θ] ; F = ∂f/∂x, G = ∂f/∂w
+    Case("SE(2) EKF standard : F = [[I, R̂ J v dt], [0, 1]]", lambda u: _jac("standard", "F", u),
+         lambda u, d: _pose_state(_state_pose(_pose_state(POSE_ODO) + d) @ _increment(u)), U_ODO, 1e-7),
+    Case("SE(2) EKF standard : G = dt diag(R̂, 1)", lambda u: _jac("standard", "G", u),
+         lambda u, d: _pose_state(POSE_ODO @ _increment(u + d)), U_ODO, 1e-7),
+]
+
+
+@pytest.mark.parametrize("kind", ["invariant", "standard"])
+def test_se2_prediction_steps_use_these_jacobians(kind):
+    """La covariance prédite des deux filtres sur SE(2) (un tirage et en lot) est F P Fᵀ + G Q Gᵀ, F et G par
+    différences centrées de l'erreur propagée (écrites ici) ; la pose prédite est T̂ U."""
+    u = U_ODO[1]
+    P = np.array([[0.04, 0.01, -0.02], [0.01, 0.09, 0.03], [-0.02, 0.03, 0.25]])
+    if kind == "invariant":
+        F = central_differences(lambda d: Log3s(np.linalg.inv(_increment(u)) @ Exp3s(d) @ _increment(u)), np.zeros(3))
+        G = central_differences(lambda d: Log3s(np.linalg.inv(_increment(u)) @ _increment(u + d)), np.zeros(3))
+        step = inv.se2_invariant_predict
+    else:
+        x = _pose_state(POSE_ODO)
+        F = central_differences(lambda d: _pose_state(_state_pose(x + d) @ _increment(u)), np.zeros(3))
+        G = central_differences(lambda d: _pose_state(POSE_ODO @ _increment(u + d)), np.zeros(3))
+        step = inv.se2_standard_predict
+    T, Pp = step(_odo, POSE_ODO, P, u)
+    expected = F @ P @ F.T + G @ _odo.Q @ G.T
+    np.testing.assert_allclose(Pp, expected, rtol=1e-7, atol=1e-10)
+    np.testing.assert_allclose(T, POSE_ODO @ _increment(u), rtol=1e-12, atol=1e-12)
+    family = inv.se2_family(kind)
+    Tb, Pb = family.predict_many(_odo, (POSE_ODO[None], P[None]), u[None], 0)
+    np.testing.assert_allclose(Pb[0], expected, rtol=1e-7, atol=1e-10)
+    np.testing.assert_allclose(Tb[0], T, rtol=1e-12, atol=1e-12)
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])

@@ -204,18 +204,27 @@ def test_bokeh_tick_formatter_runs_in_javascript():
     node = shutil.which("node")
     if node is None:
         pytest.fail("Node.js introuvable : il est requis pour la construction (mermaid-cli).")
-    def run(formatter, ticks):
-        # Bokeh passe les « args » du formateur comme variables nommées du code
+    def run(formatter, ticks, axis=True):
+        # Bokeh passe les « args » du formateur comme variables nommées du code, avec la graduation
+        # (tick), son rang (index) et toutes les graduations de l'axe (ticks)
         names = ", ".join(formatter.args)
         values = ", ".join(json.dumps(v) for v in formatter.args.values())
-        script = (f"const f = (tick, {names}) => {{ {formatter.code} }};\n"
-                  f"console.log(JSON.stringify({json.dumps(ticks)}.map(t => f(t, {values}))));")
+        script = (f"const f = (tick, index, ticks, {names}) => {{ {formatter.code} }};\n"
+                  f"const all = {json.dumps(ticks)};\n"
+                  f"console.log(JSON.stringify(all.map((t, i) => {'f(t, i, all, ' if axis else 'f(t, i, [t], '}{values}))));")
         return json.loads(subprocess.run([node, "-e", script], capture_output=True, text=True, check=True).stdout)
 
+    # graduation par graduation (axe d'une seule graduation)
     ticks = [0, 0.5, -0.25, 2, 1500, 25000, 1e-5, 3.5e-7, 2.5e7, -1e-4]
-    assert run(bokeh_tick_formatter(), ticks) == [
-        "0", "0,5", f"{M}0,25", "2", f"1{NN}500", f"25{NN}000", f"1{NN}×{NN}10⁻⁵",
-        f"3,5{NN}×{NN}10⁻⁷", f"2,5{NN}×{NN}10⁷", f"{M}1{NN}×{NN}10⁻⁴"]
+    assert run(bokeh_tick_formatter(), ticks, axis=False) == [
+        "0", "0,5", f"{M}0,25", "2", f"1{NN}500", f"25{NN}000", "10⁻⁵",
+        f"3,5{NN}×{NN}10⁻⁷", f"2,5{NN}×{NN}10⁷", f"{M}10⁻⁴"]
+    # un axe : une seule écriture, en puissances de dix dès qu'une graduation l'exige
+    assert run(bokeh_tick_formatter(), [1e-4, 1e-2, 1, 100, 1e4, 1e6]) == [
+        "10⁻⁴", "10⁻²", "10⁰", "10²", "10⁴", "10⁶"]
+    assert run(bokeh_tick_formatter(), [0, 5e5, 1e6, 1.5e6]) == ["0", f"5{NN}×{NN}10⁵", "10⁶", f"1,5{NN}×{NN}10⁶"]
+    assert run(bokeh_tick_formatter(), [10, 100, 1000, 10000, 100000]) == [
+        "10", "100", f"1{NN}000", f"10{NN}000", f"100{NN}000"]
     # un axe d'années : sans séparateur de milliers
     assert run(bokeh_tick_formatter(group_thousands=False), [1871, 1880, 1960, 1970.5]) == [
         "1871", "1880", "1960", "1970,5"]
@@ -237,3 +246,18 @@ def test_year_axes_of_the_slider_figures_have_no_thousands_separator():
 
     assert _is_year_axis("année") and _is_year_axis("années (1871–1970)")
     assert not _is_year_axis("temps (s)") and not _is_year_axis("débit (10⁸ m³ par an)")
+
+
+# --------------------------------------------------------------------------- relecture (issue 36)
+
+
+def test_format_fractions_writes_the_hand_computed_fractions():
+    from kalman_course.numbers import format_fractions
+
+    assert format_fractions([2 / 3, 17 / 8, 43 / 21]) == "2/3, 17/8, 43/21"
+    assert format_fractions(-0.5) == f"{M}1/2"
+    assert format_fractions([[0.26]], max_denominator=4) == "1/4"  # la plus proche de dénominateur ≤ 4
+    with pytest.raises(kc.KalmanInputError, match="finis"):
+        format_fractions([1.0, float("nan")])
+    with pytest.raises(kc.KalmanInputError, match="max_denominator"):
+        format_fractions([1.0], max_denominator=0)

@@ -327,3 +327,14 @@ def test_particle_sliders_default_position_is_the_chapter_run():
     np.testing.assert_array_equal(run["gap"], pf.x[:, 0] - kf.x[:, 0])
     assert axes[0].labels()[-1] == "10\u202f000"
     np.testing.assert_array_equal(run["ess"], pf.ess / 1000)
+
+
+def test_resampling_never_returns_an_index_past_the_last_particle_under_rounding():
+    """Issue 34 : avec u à un ulp de 1, la dernière position (u + N − 1)/N s'arrondit à 1 exactement ; et la somme
+    cumulée de 27 poids égaux s'arrête à 1 − 8 × 10⁻¹⁶. Aucun indice N, et jamais une particule de poids nul."""
+    u = np.nextafter(1.0, 0.0)
+    assert (u + 9) / 10 == 1.0
+    assert kc.systematic_resample(np.full(10, 0.1), u)[-1] == 9
+    w = np.r_[np.full(9, 1 / 9), 0.0]
+    assert kc.systematic_resample(w, u)[-1] == 8
+    assert kc.systematic_resample(np.full(27, 1 / 27), 0.99999999999999)[-1] == 26

@@ -200,3 +200,22 @@ def test_contents_numbers_do_not_run_into_titles_and_parts_are_the_book_parts(pd
     captions = [p["caption"] for p in yaml.safe_load((ROOT / "_toc.yml").read_text())["parts"]]
     assert len(parts) == len(captions), parts
     assert "Réponses du quiz" not in parts
+
+
+# --------------------------------------------------------------------------- relecture (issue 36)
+
+
+def test_algorithm_boxes_proofs_and_quiz_answers_are_in_french(pdf_build):
+    """Les encadrés d'algorithme sont titrés « Algorithme » (le site dit « Algorithme 7 » ; le LaTeX de
+    sphinx-proof disait « Algorithm ») ; la démonstration du filtrage parallèle est titrée
+    « Démonstration » ; le corrigé des quiz donne l'erreur de chaque mauvaise réponse."""
+    flat = pdf_build["flat"]
+    boxes = len(re.findall(r"```\{prf:algorithm\}", "".join((ROOT / f"{d}.md").read_text() for d in _toc_docs())))
+    assert boxes >= 9
+    assert flat.count("Algorithme") >= boxes
+    assert not re.search(r"\bAlgorithm\b", flat)
+    assert "Démonstration" in flat and "Proof." not in flat
+    # un message de mauvaise réponse, dans le corrigé en fin de chapitre (quiz du filtre gaussien)
+    answers = flat.split("Réponses du quiz")
+    assert len(answers) > 20
+    assert any("L'EKF n'a pas de points sigma, et le GHKF en a" in part for part in answers[1:])

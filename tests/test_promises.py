@@ -1203,6 +1203,11 @@ def _gaussian_large_uncertainty():
     (x0, x1), (y0, y1) = _static("gaussien-banane-regles").ranges_at(0, *position("gaussien-banane-regles",
                                                                                     bearing_std=60.0))
     assert x0 <= run["lin_x"].min() and run["lin_x"].max() <= x1 and y0 <= run["gh_y"].min()  # tout est visible
+    # le nuage gris est celui de 60° (issue 36) : sa moyenne est la vraie, à l'erreur de Monte-Carlo près
+    cloud = np.column_stack([run["cloud_x"], run["cloud_y"]])
+    assert np.all(np.abs(cloud.mean(axis=0) - [run["truth_mx"][0], run["truth_my"][0]])
+                  < 4 * cloud.std(axis=0) / np.sqrt(len(cloud)))
+    assert np.ptp(run["cloud_x"]) > 1.5  # il fait plus du demi-cercle (r = 1 m)
 
 
 @promise("filtre-gaussien", 1, 2)
@@ -1271,6 +1276,49 @@ def _choice_particle_filter():
         run = at("choix-incertitude", prior_std=s)
         assert np.all(run["pf_nees"] > run["band_hi"]), s  # partout hors de la bande
         assert run["pf_rmse"][0] > 10 * run["iekf_rmse"][0], s  # et loin de la cible
+
+
+# =========================================================================== filtrage invariant (issue 35)
+
+_INV = "invariant-curseurs"
+
+
+def _inv(**values):
+    run = at(_INV, **values)
+    return {k: float(run[k][0]) for k in ("inv_nees_mean", "std_nees_mean", "inv_rmse_mean", "std_rmse_mean")}
+
+
+@promise("filtrage-invariant", 1, 1)
+def _invariant_heading():
+    runs = [_inv(heading_std=h) for h in (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)]
+    std = [r["std_nees_mean"] for r in runs]
+    assert 0.5 < runs[0]["std_nees_mean"] < 1.5 and 0.5 < runs[0]["inv_nees_mean"] < 1.5  # à 0°, cohérents
+    assert abs(runs[0]["std_rmse_mean"] - runs[0]["inv_rmse_mean"]) < 1e-3  # et confondus
+    assert runs[1]["std_nees_mean"] > 1.5  # dès 15°, la NEES de l'EKF standard dépasse 1
+    assert all(b > a for a, b in zip(std[1:], std[2:]))  # puis grimpe…
+    assert 1e3 < std[-1] < 1e4  # … jusqu'à plus d'un millier à 90°
+    assert all(0.5 < r["inv_nees_mean"] < 1.5 for r in runs)  # l'EKF invariant reste près de 1
+    assert "EKF invariant" in readout(_INV, heading_std=90.0) and "NEES" in readout(_INV, heading_std=90.0)
+
+
+@promise("filtrage-invariant", 1, 2)
+def _invariant_gnss_period():
+    fast, slow = _inv(heading_std=45.0, gnss_period=0.4), _inv(heading_std=45.0, gnss_period=2.0)
+    assert slow["inv_rmse_mean"] > fast["inv_rmse_mean"] and slow["std_rmse_mean"] > fast["std_rmse_mean"]
+    assert slow["std_nees_mean"] > 3 * fast["std_nees_mean"]  # plusieurs fois plus forte à 2 s
+    for r in (fast, slow, _inv(heading_std=45.0, gnss_period=1.0)):
+        assert 0.5 < r["inv_nees_mean"] < 1.5  # l'invariant reste cohérent
+        assert r["std_nees_mean"] > 10  # l'EKF standard ne l'est jamais
+
+
+@promise("filtrage-invariant", 1, 3)
+def _invariant_odometry_noise():
+    base = _inv(heading_std=45.0)
+    noisy, quiet = _inv(heading_std=45.0, odometry_scale=3.0), _inv(heading_std=45.0, odometry_scale=0.3)
+    assert 3.0 < base["std_nees_mean"] / noisy["std_nees_mean"] < 8.0  # un facteur 6 environ à × 3
+    assert 6.0 < quiet["std_nees_mean"] / base["std_nees_mean"] < 15.0  # environ dix fois plus forte à × 0,3
+    for r in (base, noisy, quiet):
+        assert 0.5 < r["inv_nees_mean"] < 1.5
 
 
 # =========================================================================== plusieurs cibles (issue 37)

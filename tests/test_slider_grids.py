@@ -549,3 +549,51 @@ def test_se3_grid_reprojection_and_final_pose_against_least_squares():
 def test_tension_and_tag_are_in_the_registry_with_their_chapter_grids():
     np.testing.assert_array_equal(ki.slider_grid("tension-curseurs").series["x"], ki.voltage_grid().series["x"])
     np.testing.assert_array_equal(ki.slider_grid("tag-curseurs").series["err"], ki.tag_grid().series["err"])
+
+
+# --------------------------------------------------------------------------- relecture (issue 36)
+
+
+@pytest.mark.parametrize("name", ki.slider_names())
+def test_each_slider_changes_the_readout(name):
+    """Chaque curseur d'une figure qui a une lecture la change : déplacé seul depuis la position par défaut,
+    il donne au moins une autre lecture (le curseur σr de l'EKF ne changeait rien à la sienne)."""
+    spec = ki.slider_spec(name)
+    if spec.readout is None:
+        pytest.skip("pas de lecture sous les curseurs")
+    grid = spec.grid()
+    default = grid.default_index
+    reference = spec.text_at(*default)
+    for a, n in enumerate(grid.shape):
+        texts = {spec.text_at(*(default[:a] + (i,) + default[a + 1:])) for i in range(n) if i != default[a]}
+        assert texts - {reference}, f"{name} : le curseur {grid.axes[a].symbol} ne change pas la lecture"
+
+
+def test_likelihood_readout_gives_the_units_of_the_estimates():
+    """« R̂ = 15 099 (10⁸ m³ par an)² » : les estimations citées sous les curseurs du Nil ont leur unité."""
+    spec = ki.slider_spec("vraisemblance-nil")
+    text = spec.text_at(*spec.grid().default_index)
+    for symbol in ("R̂", "Q̂"):
+        assert re.search(symbol + r" = [−\d\u202f,]+\u00a0\(10⁸ m³ par an\)²", text), text
+
+
+def test_figure_details_of_the_newest_chapters():
+    """Détails relevés à la relecture (issue 36) : la bande verte de « Quel filtre choisir ? » se voit (sa
+    surface était à 5 % d'opacité) et σ₀ = 1 km s'écrit « 1 km » ; « 1 processeur(s) » ; les bandes grises des
+    virages couvrent tout l'axe de l'erreur (elles s'arrêtaient à 120 m sur un axe qui monte à 200)."""
+    from kalman_course.interactive import tracking
+
+    choice = ki.slider_spec("choix-incertitude")
+    band = next(g for p in choice.panels for g in p.glyphs if g.kind == "band")
+    assert 0.25 * band.alpha >= 0.2  # opacité de la surface (static.py : 0,25 × alpha)
+    assert choice.grid().axes[0].labels()[-1] == "1\u00a0km"
+    parallel = ki.slider_spec("parallele-processeurs")
+    grid = parallel.grid()
+    one = tuple(0 if a == 0 else d for a, d in enumerate(grid.default_index))
+    assert parallel.text_at(*one).startswith("un seul processeur") and "(s)" not in parallel.text_at(*one)
+    fading = ki.slider_spec("manoeuvre-oubli-curseurs")
+    static = fading.static()
+    panel = next(k for k, p in enumerate(fading.panels) if any(g.column == "turn" for g in p.glyphs))
+    for index in np.ndindex(*static.grid.shape):
+        _, (lo, hi) = static.ranges_at(panel, *index)
+        assert tracking.TURN_BAND > hi and lo <= 0.0, (index, hi)

@@ -243,3 +243,71 @@ def test_imm_slider_grid_equals_filterpy_immestimator():
             imm.update(z.reshape(2, 1))
             mus.append(imm.mu[1])
         assert np.allclose(grid.run(*index)["mu"], mus, rtol=1e-9, atol=1e-12), index
+
+
+# --------------------------------------------------------------------------- relecture (issue 36)
+
+
+def test_simulated_turns_have_the_centripetal_acceleration_the_chapter_cites():
+    """« 0,12 rad/s … vω = 6 m/s² » (et 4 m/s² au second virage), et non 2,4 m/s² (le changement de cap en
+    radians) : accélération mesurée par différences finies des vitesses de la trajectoire simulée."""
+    truth, _ = man.simulate_target(0)
+    t = man.DT * np.arange(1, man.N_STEPS + 1)
+    acc = np.hypot(*np.diff(truth[:, 2:], axis=0).T) / man.DT  # |Δv| / Δt entre t[k] et t[k+1]
+    for (start, end, _), cited in zip(man.TURNS, (6.0, 4.0)):
+        inside = (t[1:] > start + 1) & (t[1:] <= end)
+        # un pas de rotation ωΔt : |Δv| = 2 v sin(ωΔt / 2), soit vω à 0,1 % près
+        assert np.allclose(acc[inside], cited, rtol=2e-3)
+
+
+def test_imm_of_the_study_is_cautious_not_consistent():
+    """Pas à pas, la NEES moyenne (50 tirages) de l'IMM est le plus souvent sous l'intervalle à 95 % d'un
+    filtre cohérent (prudent), rarement dedans, et au-dessus seulement pendant les virages ; sa moyenne sur le
+    vol tombe dans l'intervalle par compensation. Comptes refaits ici sur les NEES de l'étude."""
+    st = man.manoeuvre_study()
+    lo, hi = scipy.stats.chi2.ppf([0.025, 0.975], 4 * man.N_RUNS) / man.N_RUNS
+    settled = st.t > 10.0
+    e = st.nees[st.index("IMM"), settled]
+    below, inside, above = st.band_shares("IMM")
+    assert (below, inside, above) == pytest.approx((np.mean(e < lo), np.mean((e >= lo) & (e <= hi)),
+                                                     np.mean(e > hi)))
+    assert below > 0.5 and inside < 0.25 and 0 < above < 0.3
+    assert st.turning[settled][e > hi].all()  # au-dessus : seulement dans un virage (ou juste après)
+    assert lo < st.nees_mean[st.index("IMM")] < hi  # la moyenne sur le vol, elle, tombe dedans
+    assert st.band_shares("agité")[0] > 0.5  # l'agité est prudent de même
+    for name in ("oubli", "adaptatif"):  # trop sûrs d'eux dans les virages et juste après
+        assert st.band_shares(name)[2] > 0.3
+
+
+def test_gate_exercise_loses_the_track_for_good_below_p_095():
+    """L'exercice des fenêtres de validation : à p = 0,9 et 0,95 la piste est perdue pour de bon (le filtre
+    finit à plus de 10 km de l'hélicoptère) ; à p = 0,99 la fenêtre rejette plusieurs fois plus de positions
+    que de NIS du filtre sans fenêtre au-delà du même seuil (environ 278 (1 − p)), puis retrouve la piste."""
+    track = heli.helicopter_track("position")
+    plain = heli.helicopter_filter("position")
+    for p in (0.9, 0.95):
+        res = heli.helicopter_filter("position", gate=p)
+        assert heli.lost_track_time(res, track) < 70.0
+        assert np.hypot(*(res.x[-1, :2] - track.y[-1, :2])) > 1e4
+        assert res.rejected.sum() > 0.8 * len(track.t)
+    res = heli.helicopter_filter("position", gate=0.99)
+    over = int((kc.nis(plain) > scipy.stats.chi2.ppf(0.99, 2)).sum())
+    assert abs(over - 278 * 0.01) <= 3  # sans fenêtre : conforme au modèle
+    assert res.rejected.sum() > 3 * over
+    assert np.hypot(*(res.x[-1, :2] - track.y[-1, :2])) < 10.0  # piste retrouvée
+
+
+def test_fading_memory_divides_the_weight_of_a_measurement_by_alpha_squared_per_step():
+    """« Le poids d'une mesure vieille de dix pas est divisé par α²⁰ » : sur un modèle constant sans bruit
+    d'état (A = C = 1, Q = 0), le filtre à mémoire évanescente rend la moyenne des mesures pondérées par
+    α^{−2(k−j)} et de l'a priori (poids α^{−2k} / P₀), forme close écrite ici."""
+    alpha, R, P0, x0 = 1.2, 4.0, 9.0, 1.5
+    y = np.random.default_rng(5).normal(3.0, 2.0, 25)
+    res = kc.kalman_filter(kc.LinearGaussianModel(1.0, 1.0, 0.0, R), y[:, None], [x0], [[P0]], fading=alpha)
+    for k in range(1, len(y) + 1):
+        w = alpha ** (-2.0 * (k - np.arange(1, k + 1))) / R  # mesure j : poids (1/R) α^{−2(k−j)}
+        w0 = alpha ** (-2.0 * k) / P0
+        assert res.x[k - 1, 0] == pytest.approx((w0 * x0 + w @ y[:k]) / (w0 + w.sum()), rel=1e-12)
+        assert res.P[k - 1, 0, 0] == pytest.approx(1.0 / (w0 + w.sum()), rel=1e-12)
+    # dix pas : le poids relatif de la mesure j = k − 10 est divisé par α²⁰ (≈ 38 pour α = 1,2)
+    assert (alpha ** -20) == pytest.approx(1 / 38.34, rel=1e-3)

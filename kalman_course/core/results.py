@@ -9,12 +9,17 @@ import numpy as np
 from .linalg import gram
 from .validation import KalmanInputError
 
-__all__ = ["FilterResult", "FilterRuns", "FilterHistory", "freeze", "freeze_fields"]
+__all__ = ["FilterResult", "FilterRuns", "FilterHistory", "PoseAliases", "freeze", "freeze_fields"]
 
 
 def freeze(arr: np.ndarray, dtype: type = float) -> np.ndarray:
     """Copie en lecture seule (les résultats sont immuables), de type ``dtype`` (``float`` par défaut ;
-    ``bool`` ou ``np.intp`` pour des masques et des indices)."""
+    ``bool`` ou ``np.intp`` pour des masques et des indices). Un tableau déjà figé par cette fonction
+    (``float64``, en lecture seule, propriétaire de ses données) est rendu tel quel : reconstruire un
+    résultat à partir d'un autre ne recopie pas ses tableaux."""
+    if (dtype is float and isinstance(arr, np.ndarray) and arr.dtype == np.float64 and not arr.flags.writeable
+            and arr.flags.owndata):
+        return arr
     out = np.array(arr, dtype=dtype, copy=True)
     out.setflags(write=False)
     return out
@@ -144,6 +149,21 @@ class FilterRuns(FilterResult):
         return FilterResult(x=self.x[i], P=pick(self.P), x_pred=self.x_pred[i], P_pred=pick(self.P_pred),
                             K=pick(self.K), innovation=self.innovation[i], S=pick(self.S),
                             observed=self.observed[i], n_iter=self.n_iter[i])
+
+
+class PoseAliases:
+    """Noms de pose des résultats dont l'estimation est une pose (filtres sur SE(3) et SE(2)) : ``T`` pour
+    ``x``, ``T_pred`` pour ``x_pred``."""
+
+    @property
+    def T(self) -> np.ndarray:
+        """Poses a posteriori (…, T, d, d) : ``x``."""
+        return self.x
+
+    @property
+    def T_pred(self) -> np.ndarray:
+        """Poses prédites (…, T, d, d) : ``x_pred``."""
+        return self.x_pred
 
 
 class FilterHistory:

@@ -40,17 +40,23 @@ CHAPTER_TITLES: dict[str, str] = {
     "tp-ekf-tag": "TP 2 — Le filtre de Kalman étendu : suivre le tag radio",
     "tp-ukf-particulaire": "TP 3 — UKF et filtre particulaire : le pendule",
     "tp-lissage-em": "TP 4 — Lisser et apprendre : le Nil",
+    "tp-helicoptere-samu": "TP 5 — Pister l'hélicoptère du SAMU 31",
+    "td-cibles-reelles": "TD 4 — Pister des cibles réelles à la main",
+    "td-autres-formes": "TD 5 — Autres formes du filtre à la main",
+    "sujet-examen": "Sujet d'examen",
     "td-filtre-lineaire": "TD 1 — Le gain de Kalman à la main",
     "td-filtres-a-points": "TD 2 — Filtres à points : calculs à la main",
     "td-lissage-em": "TD 3 — Lissage et EM à la main",
     "filtre-gaussien": "Un seul filtre gaussien : linéarisation, points sigma, cubature, Gauss–Hermite",
     "quel-filtre": "Quel filtre choisir ?",
     "filtrage-parallele": "Filtrer en parallèle dans le temps",
+    "filtrage-invariant": "Filtrage invariant sur les groupes de Lie",
+    "td-filtrage-invariant": "TD 6 — L'EKF invariant à la main",
     # plusieurs cibles (issue 37)
     "fouillis-association": "Fouillis et association",
     "gestion-pistes": "Gérer les pistes",
-    "td-plusieurs-cibles": "TD 4 — Plusieurs cibles à la main",
-    "tp-plusieurs-cibles": "TP 5 — Plusieurs cibles : l'association probabiliste (PDA)",
+    "td-plusieurs-cibles": "TD 7 — Plusieurs cibles à la main",
+    "tp-plusieurs-cibles": "TP 6 — Plusieurs cibles : l'association probabiliste (PDA)",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

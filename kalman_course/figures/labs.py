@@ -12,7 +12,7 @@ import textwrap
 
 import numpy as np
 
-from ..scenarios.labs import nile_lab, pda_lab, pendulum_lab, tag_lab, voltage_lab
+from ..scenarios.labs import LAB_SAMU_GATE, nile_lab, pda_lab, pendulum_lab, samu_lab, tag_lab, voltage_lab
 from ._registry import new_figure, register
 from .likelihood import FLOW, _year_formatter
 
@@ -134,8 +134,56 @@ def nile_lab_figure(rts_step=None, m_step=None):
     return fig
 
 
+@register("tp-samu", chapter="tp-helicoptere-samu",
+          title="TP 5 : votre porte et votre IMM contre ceux du paquet sur le vol de l'hélicoptère SAMU 31")
+def samu_lab_figure(cv_model=None, nis_gate=None, van_loan=None, imm_mix=None, mode_probabilities=None,
+                    imm_merge=None):
+    from ..numbers import format_number
+
+    run = samu_lab(cv_model, nis_gate, van_loan, imm_mix, mode_probabilities, imm_merge)
+    t, y, y_bad, bad = run.data["t"], run.data["y"], run.data["y_bad"], run.data["outliers"]
+    ref, you = run.reference, run.student
+    fig, (ax, az) = new_figure(1, 2, width=10.0, height=4.6, gridspec_kw={"width_ratios": [1.0, 1.25]})
+    km = 1e-3
+    ax.plot(y[:, 0] * km, y[:, 1] * km, "+", color="0.55", ms=4, label="positions mesurées")
+    ax.plot(y_bad[bad, 0] * km, y_bad[bad, 1] * km, "x", color="crimson", ms=8, mew=2, label="positions aberrantes")
+    ax.plot(ref["gate_x"][:, 0] * km, ref["gate_x"][:, 1] * km, color=PACKAGE, lw=2.0, label="paquet : porte")
+    rejected = ref["rejected"]
+    ax.plot(y_bad[rejected, 0] * km, y_bad[rejected, 1] * km, "o", mfc="none", color=PACKAGE, ms=9,
+            label="rejetées par le paquet")
+    if you["gate_x"] is not None:
+        ax.plot(you["gate_x"][:, 0] * km, you["gate_x"][:, 1] * km, "--", color=YOURS, lw=1.5, label="votre filtre")
+        mine = you["rejected"]
+        ax.plot(y_bad[mine, 0] * km, y_bad[mine, 1] * km, "s", mfc="none", color=YOURS, ms=12,
+                label="rejetées par votre porte")
+    ax.set_xlabel("est (km)")
+    ax.set_ylabel("nord (km)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_title(f"Porte p = {format_number(LAB_SAMU_GATE, decimals=3)} sur six positions corrompues",
+                 fontsize=9)
+    ax.legend(loc="lower left", fontsize=7)
+    turn = az.twinx()
+    turn.fill_between(run.data["rate_t"], np.abs(run.data["rate"]), color="0.85", lw=0, zorder=0)
+    turn.set_ylabel("vitesse de virage mesurée, en gris (°/s)", color="0.35")
+    turn.set_ylim(0.0, 1.03 * float(np.max(np.abs(run.data["rate"]))))
+    az.set_zorder(turn.get_zorder() + 1)
+    az.patch.set_visible(False)
+    az.plot(t, ref["mu"][:, 1], color=PACKAGE, lw=1.6, label="paquet : kc.imm_filter")
+    if you["mu"] is not None:
+        az.plot(t, you["mu"][:, 1], "o", ms=2.5, mfc="none", color=YOURS, label="votre IMM")
+    az.set_ylim(-0.03, 1.03)
+    az.set_xlabel("temps depuis la première position (s)")
+    az.set_ylabel("probabilité du régime agité μ (sans unité)")
+    az.set_title("IMM calme/agité : vos points doivent tomber sur la courbe du paquet", fontsize=9)
+    az.legend(loc="upper left", fontsize=8)
+    for a in (ax, az):
+        a.grid(alpha=0.3)
+    _note(fig, run.message)
+    return fig
+
+
 @register("tp-pda", chapter="tp-plusieurs-cibles",
-          title="TP 5 : votre PDA et celle du paquet sur l'hélicoptère SAMU 31 dans un fouillis dense")
+          title="TP 6 : votre PDA et celle du paquet sur l'hélicoptère SAMU 31 dans un fouillis dense")
 def pda_lab_figure(pda_weights=None, pda_update=None):
     run = pda_lab(pda_weights, pda_update)
     truth, det, t = run.data["truth"], run.data["detections"], run.data["t"]

@@ -75,7 +75,7 @@ def scene_figure():
 
 
 @register("association-porte", chapter=ASSOCIATION_CHAPTER,
-          title="Le relevé de t = 140 s : pistes prédites, portes, détections, affectations du NN et du GNN")
+          title="Le relevé de t = 140 s : pistes prédites, fenêtres de validation, détections, affectations du NN et du GNN")
 def gate_snapshot_figure():
     snap = tr.scan_snapshot()
     names = tr.truth_names()
@@ -94,7 +94,7 @@ def gate_snapshot_figure():
             a = snap.owner[t]
             ax.plot(gates[t][:, 0], gates[t][:, 1], color=COLOURS[a], lw=1.2)
             ax.plot(*(snap.x_pred[t, :2] - centre), "+", color=COLOURS[a], ms=12, mew=2,
-                    label=f"piste {snap.ids[t]} ({names[a]}) prédite, sa porte")
+                    label=f"piste {snap.ids[t]} ({names[a]}) prédite, sa fenêtre")
             ax.plot(*(snap.truth[a] - centre), "*", color=COLOURS[a], ms=11, mec="black", mew=0.5)
         near = np.all(np.abs(snap.detections - centre) < half, axis=1)
         for j in np.flatnonzero(near):
@@ -194,7 +194,7 @@ def confirmation_figure():
     ax.set_ylim(1e-6, 2.0)
     ax.set_xlabel("fausses détections par relevé dans la zone (nombre)")
     ax.set_ylabel("probabilité de confirmation (sans unité)")
-    ax.set_title(f"Porte d'une piste qui vient de naître : {fr(volume / 1e6, '.2f')} km² "
+    ax.set_title(f"Fenêtre de validation d'une piste qui vient de naître : {fr(volume / 1e6, '.2f')} km² "
                  f"(P_G = {fr(traffic.GATE_PROBABILITY, '.2f')}), P_D = {fr(traffic.DETECTION_PROBABILITY, '.1f')}",
                  fontsize=9)
     ax.legend(loc="lower right", fontsize=7, ncol=2)
@@ -220,11 +220,11 @@ def gospa_figure():
     return fig
 
 
-# --------------------------------------------------------------------------- TD 4
+# --------------------------------------------------------------------------- TD 7
 
 
 @register("td-pda", chapter="td-plusieurs-cibles",
-          title="TD 4 : la correction PDA à la main — un mélange de trois gaussiennes et sa gaussienne résumée")
+          title="TD 7 : la correction PDA à la main — un mélange de trois gaussiennes et sa gaussienne résumée")
 def pda_by_hand_figure():
     c = tutorials.PDA_BY_HAND
     step = tutorials.pda_by_hand()
@@ -240,7 +240,7 @@ def pda_by_hand_figure():
     parts = [b * scipy.stats.norm(m, np.sqrt(v)).pdf(grid) for b, m, v in zip(beta, means, variances)]
     fig, ax = new_figure(width=7.5, height=3.8)
     half = np.sqrt(gamma * S)
-    ax.axvspan(x0 - half, x0 + half, color="0.92", label=f"porte (P_G = {fr(c['P_G'], '.1f')})")
+    ax.axvspan(x0 - half, x0 + half, color="0.92", label=f"fenêtre (P_G = {fr(c['P_G'], '.1f')})")
     ax.plot(grid, scipy.stats.norm(x0, np.sqrt(P0)).pdf(grid), color="0.4", ls=":", lw=1.5,
             label="prédiction N(0 ; 3)")
     for j, (part, style) in enumerate(zip(parts, ("--", "-.", "-."))):

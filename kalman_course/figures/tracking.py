@@ -53,10 +53,21 @@ def helicopter_flight():
     ax.plot(f.east / 1e3, f.north / 1e3, ".", color="tab:blue", ms=3, label="positions", zorder=3)
     ax.plot(0, 0, "s", color="black", ms=7, label="première position", zorder=4)
     ax.plot(f.east[-1] / 1e3, f.north[-1] / 1e3, "^", color="black", ms=8, label="dernière position", zorder=4)
+    track_km = np.column_stack([f.east, f.north]) / 1e3
+    placed: list[np.ndarray] = []
     for minute in range(1, int(f.duration // 60) + 1):  # repères de temps le long du vol
         k = int(np.searchsorted(f.t, 60.0 * minute))
-        ax.annotate(f"{minute} min", (f.east[k] / 1e3, f.north[k] / 1e3), xytext=(6, 0),
-                    textcoords="offset points", fontsize=8, color="0.25")
+        # étiquette à 0,45 km du repère, dans la direction (parmi huit) la plus loin de la trajectoire et
+        # des étiquettes déjà posées : l'aller et le retour passent au même endroit (1 et 4 min)
+        angles = np.deg2rad(np.arange(0, 360, 45))
+        spots = track_km[k] + 0.45 * np.column_stack([np.cos(angles), np.sin(angles)])
+        obstacles = np.vstack([track_km] + [np.repeat(q[None], 40, axis=0) for q in placed])
+        clearance = [np.min(np.hypot(*(obstacles - spot).T)) for spot in spots]
+        spot = spots[int(np.argmax(clearance))]
+        placed.append(spot)
+        ax.annotate(f"{minute} min", track_km[k], xytext=tuple(spot), textcoords="data", fontsize=8,
+                    color="0.2", ha="center", va="center",
+                    arrowprops=dict(arrowstyle="-", color="0.5", lw=0.6, shrinkA=0, shrinkB=3))
         ax.plot(f.east[k] / 1e3, f.north[k] / 1e3, "o", color="0.25", ms=4, zorder=4)
     ax.set_title(f"{len(f)} positions ADS-B en {fr(f.duration / 60, '.1f')} min")
     ax.legend(loc="upper right", fontsize=8)
@@ -141,7 +152,7 @@ def two_sensors():
         err = np.hypot(*(np.asarray(track.y)[rows, :2] - res.x_pred[rows, :2]).T)
         rms = heli.prediction_rms(res, track)
         ax.plot(np.asarray(track.t)[rows], err, color=color, lw=1.0,
-                label=f"{label} (moyenne quadratique {fr(rms, '.1f')} m)")
+                label=f"{label} (REQM {fr(rms, '.1f')} m)")
     ax.set_yscale("log")
     ax.set_xlabel("temps (s)")
     ax.set_ylabel("|position mesurée − prédite| (m)")
@@ -152,7 +163,7 @@ def two_sensors():
 
 
 @register("capteurs-porte", chapter=SENSORS_CHAPTER,
-          title="La porte : six positions aberrantes rejetées, puis une piste perdue derrière sa porte")
+          title="La fenêtre de validation : six positions aberrantes rejetées, puis une piste perdue derrière sa fenêtre")
 def gate_figure():
     track = heli.helicopter_track("position")
     study = heli.gate_study()
@@ -167,13 +178,13 @@ def gate_figure():
     win = slice(max(k - 12, 0), k + 14)
     ax.plot(track.y[win, 0], track.y[win, 1], "+", color=MEASURED, ms=7, label="positions vraies (mesurées)")
     ax.plot(y_bad[k, 0], y_bad[k, 1], "x", color="crimson", ms=10, mew=2, label="position aberrante")
-    ax.plot(plain.x[win, 0], plain.x[win, 1], color=POSITION_ONLY, lw=1.5, label="sans porte")
-    ax.plot(gated.x[win, 0], gated.x[win, 1], color=FUSED, lw=1.5, ls="--", label="porte p = 0,999")
+    ax.plot(plain.x[win, 0], plain.x[win, 1], color=POSITION_ONLY, lw=1.5, label="sans fenêtre")
+    ax.plot(gated.x[win, 0], gated.x[win, 1], color=FUSED, lw=1.5, ls="--", label="fenêtre de validation p = 0,999")
     ax.set_xlabel("est (m)")
     ax.set_ylabel("nord (m)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_title(f"Une position aberrante : écart maximal {fr(study.deviation_plain, '.0f')} m\n"
-                 f"sans porte, {fr(study.deviation_gated, '.0f')} m avec", fontsize=9)
+                 f"sans fenêtre, {fr(study.deviation_gated, '.0f')} m avec", fontsize=9)
     ax.legend(loc="best", fontsize=8)
     _grid(ax)
     ax = axes[1]
@@ -182,7 +193,7 @@ def gate_figure():
     ax.plot(track.y[:, 0] / 1e3, track.y[:, 1] / 1e3, "+", color=MEASURED, ms=4, label="positions mesurées")
     ax.plot(clean.x[:, 0] / 1e3, clean.x[:, 1] / 1e3, color=FUSED, lw=1.0, label=f"q appris ({fr(q, '.1f')} m²/s³)")
     ax.plot(quiet.x[:, 0] / 1e3, quiet.x[:, 1] / 1e3, color="crimson", lw=1.4,
-            label=f"q / 100, porte p = {fr(0.999, '.3f')}")
+            label=f"q / 100, fenêtre p = {fr(0.999, '.3f')}")
     rej = np.asarray(quiet.rejected)
     ax.plot(track.y[rej, 0] / 1e3, track.y[rej, 1] / 1e3, "o", mfc="none", color="crimson", ms=4, alpha=0.6,
             label="positions rejetées")
@@ -205,7 +216,7 @@ def _shade_turns(ax, label=True) -> None:
 
 
 @register("manoeuvre-retard", chapter=MANOEUVRE_CHAPTER,
-          title="Un filtre réglé pour la ligne droite décroche dans le virage ; réglé pour virer, il tremble")
+          title="Un filtre réglé pour la ligne droite décroche dans le virage ; réglé pour virer, il suit le bruit des relevés")
 def lag_figure():
     st = man.manoeuvre_study()
     truth, y, ex = st.truth, st.y, st.example
@@ -226,8 +237,8 @@ def lag_figure():
         ax.plot(st.t, st.rmse[i], color=FILTER_COLORS[name], lw=1.5, label=f"filtre {name}")
     ax.set_yscale("log")
     ax.set_xlabel("temps (s)")
-    ax.set_ylabel("erreur quadratique moyenne de position (m)")
-    ax.set_title(f"Moyenne sur {man.N_RUNS} trajectoires")
+    ax.set_ylabel("REQM de position (m)")
+    ax.set_title(f"Racine de l'erreur quadratique moyenne sur {man.N_RUNS} trajectoires", fontsize=9)
     ax.legend(loc="upper left", fontsize=8)
     _grid(ax)
     return fig
@@ -243,8 +254,8 @@ def comparison_figure():
     for name in st.names:
         ax.plot(st.t, st.rmse[st.index(name)], color=FILTER_COLORS[name], lw=1.4, label=name)
     ax.set_yscale("log")
-    ax.set_ylabel("erreur de position (m)")
-    ax.set_title(f"Erreur quadratique moyenne sur {man.N_RUNS} trajectoires")
+    ax.set_ylabel("REQM de position (m)")
+    ax.set_title(f"Racine de l'erreur quadratique moyenne (REQM) sur {man.N_RUNS} trajectoires")
     ax.legend(loc="upper left", fontsize=8, ncol=3)
     _grid(ax)
     ax = axes[1]
@@ -256,7 +267,7 @@ def comparison_figure():
     ax.axhline(4.0, color="0.3", lw=0.8, ls="--", label="n = 4")
     ax.set_yscale("log")
     ax.set_xlabel("temps (s)")
-    ax.set_ylabel("NEES moyen (sans unité)")
+    ax.set_ylabel("NEES moyenne (sans unité)")
     ax.set_title("Cohérence : l'erreur est-elle celle que P annonce ?")
     ax.legend(loc="upper left", fontsize=8)
     _grid(ax)

@@ -294,7 +294,8 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
     x0 : (n,) commun ou (N, n) ; P0 : (n, n) commune ou (N, n, n) — vérifiés par ``family.prior_many``.
     u : (T, p) commune à tous les tirages, ou (N, T, p) une suite par tirage (``(T,)`` accepté si p = 1).
 
-    Renvoie un :class:`~kalman_course.core.results.FilterRuns` : ``x``, ``x_pred`` (N, T, n), ``P``,
+    Renvoie un :class:`~kalman_course.core.results.FilterRuns` : ``x``, ``x_pred`` (N, T, n) (ou (N, T, …)
+    pour une famille dont l'estimation est une pose, ``state_shape``), ``P``,
     ``P_pred`` (N, T, n, n), ``K`` (N, T, n, m), ``innovation`` (N, T, m), ``S`` (N, T, m, m),
     ``observed`` (N, T, m), ``n_iter`` (N, T) — ``P``, ``P_pred``, ``K``, ``S`` de forme (T, …) avec la
     Riccati commune ; ``result.run(i)`` est le :class:`FilterResult` du tirage ``i``.
@@ -310,12 +311,14 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
     U = as_batch_controls("u", u, N, T, model.n_control)
     observed = ~np.isnan(Yarr)
     full = observed.all(axis=2)  # (N, T)
+    seen = observed.any(axis=(0, 2)).tolist()  # (T,) : au moins une composante observée par un tirage
     shared = family.shared_covariance and bool(full.all()) and np.ndim(P0) < 3
     state = family.prior_many(model, x0, P0, N, shared=True) if shared else family.prior_many(model, x0, P0, N)
     moments = family.moments
-    n = moments(state)[0].shape[-1]
+    X_first, P_first = moments(state)
+    x_shape, n = X_first.shape[1:], P_first.shape[-1]  # estimation (n,) ou pose (4, 4)… ; covariance (n, n)
     lead = () if shared else (N,)  # axe des tirages des covariances, gains et S
-    xs, xps = np.empty((N, T, n)), np.empty((N, T, n))
+    xs, xps = np.empty((N, T) + x_shape), np.empty((N, T) + x_shape)
     Ps, Pps = np.empty(lead + (T, n, n)), np.empty(lead + (T, n, n))
     Ks = np.zeros(lead + (T, n, m))  # gain nul pour une composante manquante : aucune correction
     nus = np.full((N, T, m), np.nan)
@@ -329,7 +332,9 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
             predicted = _predict_run_by_run(family, mk, state, U[:, k], k)
         else:
             predicted = family.predict_many(mk, state, None if U is None else U[..., k, :], k)
-        if full[:, k].all():
+        if not seen[k]:  # aucun tirage n'a de mesure à ce pas : prédiction seule, sans regroupement
+            state = predicted
+        elif full[:, k].all():
             state, corr = family.update_many(mk, predicted, Yarr[:, k], None, k)
             if shared:
                 Ks[k], nus[:, k], Ss[k], n_iter[:, k] = corr
@@ -354,6 +359,8 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
             Pps[k], Ps[k] = P_pred, P
         else:
             Pps[:, k], Ps[:, k] = P_pred, P
+    for a in (xs, Ps, xps, Pps, Ks, nus, Ss):  # figés sur place : le résultat les garde sans les recopier
+        a.setflags(write=False)
     return FilterRuns(x=xs, P=Ps, x_pred=xps, P_pred=Pps, K=Ks, innovation=nus, S=Ss,
                       observed=observed, n_iter=n_iter)
 

@@ -87,7 +87,9 @@ def _inverse_cdf(w: np.ndarray, positions: np.ndarray) -> np.ndarray:
     (une particule de poids nul n'est jamais choisie)."""
     c = np.cumsum(w)
     c[-1] = 1.0  # les arrondis ne doivent pas laisser une position au-delà de la dernière particule
-    return np.searchsorted(c, positions, side="right")
+    # une position arrondie à 1 exactement ((u + N − 1)/N avec u à un ulp de 1) : la dernière particule de
+    # poids non nul
+    return np.minimum(np.searchsorted(c, positions, side="right"), np.flatnonzero(w > 0)[-1])
 
 
 def _multinomial(w: np.ndarray, u: np.ndarray) -> np.ndarray:

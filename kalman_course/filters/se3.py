@@ -25,7 +25,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.linalg import cholesky_factor, symmetrize
-from ..core.results import FilterResult
+from ..core.results import FilterResult, PoseAliases
 from ..core.validation import (
     KalmanInputError, as_float_array, as_square_matrix, as_vector, check_pd, check_psd, shape_text,
 )
@@ -106,7 +106,7 @@ class SE3Update(NamedTuple):
 
 
 @dataclass(frozen=True, eq=False, repr=False)
-class SE3FilterResult(FilterResult):
+class SE3FilterResult(PoseAliases, FilterResult):
     r"""Sortie de :func:`se3_iterated_filter` sur ``F`` images : le résultat commun
     (:class:`~kalman_course.FilterResult`), temps en premier, dont l'estimation est une pose.
 
@@ -114,16 +114,6 @@ class SE3FilterResult(FilterResult):
     ``P``, ``P_pred`` (F, 6, 6) : covariances dans l'espace tangent à droite ; ``K`` (F, 6, 2N),
     ``innovation`` (F, 2N), ``S`` (F, 2N, 2N) : ceux de la dernière linéarisation de chaque correction
     (les outils de cohérence, NIS et blancheur, s'y appliquent) ; ``observed`` (F, 2N) ; ``n_iter`` (F,)."""
-
-    @property
-    def T(self) -> np.ndarray:
-        """Poses a posteriori (F, 4, 4)."""
-        return self.x
-
-    @property
-    def T_pred(self) -> np.ndarray:
-        """Poses prédites (F, 4, 4)."""
-        return self.x_pred
 
 
 @dataclass(frozen=True, eq=False)

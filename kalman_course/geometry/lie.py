@@ -58,6 +58,13 @@ __all__ = [
     "se3_right_jacobian_inv",
     "oplus",
     "ominus",
+    "as_se2_pose",
+    "se2_exp",
+    "se2_log",
+    "se2_inverse",
+    "se2_adjoint",
+    "se2_right_jacobian",
+    "se2_left_jacobian",
 ]
 
 #: En dessous de cet angle (rad), les coefficients sont calculés par leur développement de Taylor
@@ -366,3 +373,177 @@ def ominus(T1: Any, T0: Any) -> np.ndarray:
     r""":math:`T_1 \ominus T_0 = \mathrm{Log}(T_0^{-1}T_1)` (6,) : l'écart :math:`\delta` tel que
     :math:`T_1 = T_0 \oplus \delta`."""
     return _se3_log(_se3_inverse(as_pose("T0", T0)) @ as_pose("T1", T1))
+
+
+# --------------------------------------------------------------------------- SE(2)
+#
+# Pose plane T = [[R, p], [0, 0, 1]] (3, 3), R = Exp(θ) rotation d'angle θ, vecteur tangent
+# ξ = [ρx, ρy, θ] (translation d'abord, comme pour SE(3)), ξ^ = [[θ J, ρ], [0, 0, 0]], J = [[0, −1], [1, 0]].
+# Les coefficients en 1/θᵏ s'écrivent par l'angle moitié (aucune soustraction de nombres voisins),
+# sauf C(θ) = (θ − sin θ)/θ², remplacé par son développement de Taylor sous SE2_TAYLOR_C.
+
+#: En dessous de cet angle (rad), :math:`C(\theta) = (\theta - \sin\theta)/\theta^2` est calculé par son
+#: développement de Taylor (troncature en :math:`\theta^9/9! < 10^{-19}`) : la forme close y perdrait
+#: :math:`\varepsilon/\theta` en absolu.
+SE2_TAYLOR_C = 0.05
+
+
+def as_se2_pose(name: str, value: Any) -> np.ndarray:
+    r"""Pose plane (3, 3) :math:`\begin{bmatrix} R & p \\ 0 & 1\end{bmatrix}` de SE(2) : dernière ligne
+    :math:`[0, 0, 1]`, :math:`R^TR = I` et :math:`\det R = +1` (à :data:`ROTATION_TOL` près)."""
+    T = as_float_array(name, value)
+    if T.shape != (3, 3):
+        raise KalmanInputError(
+            f"« {name} » doit être une pose plane (3, 3) de SE(2), [[R, p], [0, 0, 1]] ; reçu {shape_text(T.shape)}."
+        )
+    if np.max(np.abs(T[2] - [0.0, 0.0, 1.0])) > ROTATION_TOL:
+        raise KalmanInputError(
+            f"« {name} » n'est pas une pose plane : sa dernière ligne doit être [0, 0, 1] ; "
+            f"reçu {array_text(T[2], decimals=4)}."
+        )
+    R = T[:2, :2]
+    err = float(np.max(np.abs(R.T @ R - np.eye(2))))
+    det = float(R[0, 0] * R[1, 1] - R[0, 1] * R[1, 0])
+    if err > ROTATION_TOL or abs(det - 1.0) > ROTATION_TOL:
+        raise KalmanInputError(
+            f"« {name} » n'est pas une pose plane : son bloc T[:2, :2] n'est pas une rotation "
+            f"(|RᵀR − I| max = {number_text(err, '.2g')}, det = {number_text(det, '.6g')} ; "
+            "attendu RᵀR = I et det R = +1)."
+        )
+    return T
+
+
+def _se2_coefficients(t: float) -> tuple[float, float, float, float]:
+    r""":math:`A = \sin\theta/\theta`, :math:`B = (1-\cos\theta)/\theta`, :math:`C = (\theta-\sin\theta)/\theta^2`,
+    :math:`D = (1-\cos\theta)/\theta^2`, exacts à l'arrondi près pour tout :math:`\theta`."""
+    a = abs(t)
+    if a < SMALL_ANGLE:
+        t2 = t * t
+        A = 1.0 - t2 / 6.0 + t2 * t2 / 120.0
+        B = t * (0.5 - t2 / 24.0 + t2 * t2 / 720.0)
+        D = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
+    else:
+        h = 0.5 * t
+        s = np.sin(h)
+        A = np.sin(t) / t
+        B = 2.0 * s * s / t  # 1 − cos θ = 2 sin²(θ/2)
+        D = B / t
+    if a < SE2_TAYLOR_C:
+        t2 = t * t
+        C = t * (1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0 - t2 * t2 * t2 / 362880.0)
+    else:
+        C = (t - np.sin(t)) / (t * t)
+    return float(A), float(B), float(C), float(D)
+
+
+def _se2_exp(xi: np.ndarray) -> np.ndarray:
+    rx, ry, t = float(xi[0]), float(xi[1]), float(xi[2])
+    A, B, _, _ = _se2_coefficients(t)
+    c, s = np.cos(t), np.sin(t)
+    # V(θ) = [[A, −B], [B, A]]
+    return np.array([[c, -s, A * rx - B * ry], [s, c, B * rx + A * ry], [0.0, 0.0, 1.0]])
+
+
+def _se2_exp_many(xi: np.ndarray) -> np.ndarray:
+    r""":func:`se2_exp` de chaque ligne de ``xi`` (N, 3) → (N, 3, 3), en bloc (mêmes formules, même branche de
+    Taylor sous :data:`SMALL_ANGLE`)."""
+    t = xi[:, 2]
+    small = np.abs(t) < SMALL_ANGLE
+    ts = np.where(small, 1.0, t)
+    t2 = t * t
+    h = np.sin(0.5 * t)
+    A = np.where(small, 1.0 - t2 / 6.0 + t2 * t2 / 120.0, np.sin(t) / ts)
+    B = np.where(small, t * (0.5 - t2 / 24.0 + t2 * t2 / 720.0), 2.0 * h * h / ts)
+    c, s = np.cos(t), np.sin(t)
+    T = np.zeros((xi.shape[0], 3, 3))
+    T[:, 0, 0], T[:, 0, 1], T[:, 0, 2] = c, -s, A * xi[:, 0] - B * xi[:, 1]
+    T[:, 1, 0], T[:, 1, 1], T[:, 1, 2] = s, c, B * xi[:, 0] + A * xi[:, 1]
+    T[:, 2, 2] = 1.0
+    return T
+
+
+def _se2_log(T: np.ndarray) -> np.ndarray:
+    t = float(np.arctan2(T[1, 0], T[0, 0]))
+    if t <= -np.pi:  # atan2(−0, −1) = −π : on rend π, dans (−π, π]
+        t = np.pi
+    h = 0.5 * t
+    # V(θ)⁻¹ = [[h cot h, h], [−h, h cot h]], h = θ/2
+    if abs(h) < SMALL_ANGLE:
+        h2 = h * h
+        g = 1.0 - h2 / 3.0 - h2 * h2 / 45.0
+    else:
+        g = h * np.cos(h) / np.sin(h)
+    px, py = float(T[0, 2]), float(T[1, 2])
+    return np.array([g * px + h * py, -h * px + g * py, t])
+
+
+def _se2_inverse(T: np.ndarray) -> np.ndarray:
+    Ti = np.eye(3)
+    Rt = T[:2, :2].T
+    Ti[:2, :2] = Rt
+    Ti[:2, 2] = -Rt @ T[:2, 2]
+    return Ti
+
+
+def _se2_adjoint(T: np.ndarray) -> np.ndarray:
+    Ad = np.eye(3)
+    Ad[:2, :2] = T[:2, :2]
+    Ad[0, 2] = T[1, 2]   # −J p = [p_y, −p_x]
+    Ad[1, 2] = -T[0, 2]
+    return Ad
+
+
+def _se2_jr(xi: np.ndarray) -> np.ndarray:
+    rx, ry, t = float(xi[0]), float(xi[1]), float(xi[2])
+    A, B, C, D = _se2_coefficients(t)
+    return np.array([[A, B, C * rx - D * ry], [-B, A, D * rx + C * ry], [0.0, 0.0, 1.0]])
+
+
+def se2_exp(xi: Any) -> np.ndarray:
+    r""":math:`\mathrm{Exp}(\xi) = \begin{bmatrix}\mathrm{Exp}(\theta) & V(\theta)\rho\\0&1\end{bmatrix}` (3, 3),
+    ``xi`` = :math:`[\rho_x, \rho_y, \theta]` (3,) (m, m, rad), avec
+
+    .. math::
+
+        \mathrm{Exp}(\theta) = \begin{bmatrix}\cos\theta & -\sin\theta\\ \sin\theta & \cos\theta\end{bmatrix},\qquad
+        V(\theta) = \begin{bmatrix}\frac{\sin\theta}{\theta} & \frac{\cos\theta - 1}{\theta}\\
+        \frac{1-\cos\theta}{\theta} & \frac{\sin\theta}{\theta}\end{bmatrix}
+
+    (:math:`V(0) = I`, développement de Taylor pour :math:`|\theta|` petit)."""
+    return _se2_exp(as_vector("xi", xi, 3))
+
+
+def se2_log(T: Any) -> np.ndarray:
+    r""":math:`\mathrm{Log}(T) = [V(\theta)^{-1}p;\ \theta]` (3,), :math:`\theta = \operatorname{atan2}(R_{21}, R_{11})
+    \in (-\pi, \pi]`, :math:`V(\theta)^{-1} = \begin{bmatrix} h\cot h & h\\ -h & h\cot h\end{bmatrix}`,
+    :math:`h = \theta/2` ; ``T`` (3, 3) pose plane."""
+    return _se2_log(as_se2_pose("T", T))
+
+
+def se2_inverse(T: Any) -> np.ndarray:
+    r""":math:`T^{-1} = \begin{bmatrix} R^T & -R^Tp \\ 0 & 1\end{bmatrix}` (3, 3)."""
+    return _se2_inverse(as_se2_pose("T", T))
+
+
+def se2_adjoint(T: Any) -> np.ndarray:
+    r""":math:`\mathrm{Ad}_T = \begin{bmatrix} R & -Jp\\ 0 & 1\end{bmatrix}` (3, 3),
+    :math:`J = \begin{bmatrix}0 & -1\\ 1 & 0\end{bmatrix}` (donc :math:`-Jp = [p_y, -p_x]^T`) :
+    :math:`T\,\mathrm{Exp}(\delta)\,T^{-1} = \mathrm{Exp}(\mathrm{Ad}_T\,\delta)`."""
+    return _se2_adjoint(as_se2_pose("T", T))
+
+
+def se2_right_jacobian(xi: Any) -> np.ndarray:
+    r"""Jacobienne à droite (3, 3) : :math:`\mathrm{Exp}(\xi + \delta) \approx \mathrm{Exp}(\xi)\,\mathrm{Exp}(J_r(\xi)\delta)`,
+
+    .. math::
+
+        J_r(\xi) = \begin{bmatrix} A & B & C\rho_x - D\rho_y\\ -B & A & D\rho_x + C\rho_y\\ 0 & 0 & 1\end{bmatrix},
+        \quad A = \frac{\sin\theta}{\theta},\ B = \frac{1-\cos\theta}{\theta},\
+        C = \frac{\theta - \sin\theta}{\theta^2},\ D = \frac{1-\cos\theta}{\theta^2}."""
+    return _se2_jr(as_vector("xi", xi, 3))
+
+
+def se2_left_jacobian(xi: Any) -> np.ndarray:
+    r"""Jacobienne à gauche (3, 3), :math:`J_l(\xi) = J_r(-\xi)` :
+    :math:`\mathrm{Exp}(\xi + \delta) \approx \mathrm{Exp}(J_l(\xi)\delta)\,\mathrm{Exp}(\xi)`."""
+    return _se2_jr(-as_vector("xi", xi, 3))

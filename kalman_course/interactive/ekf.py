@@ -51,6 +51,8 @@ def _common(tr) -> dict[str, np.ndarray]:
         "exact_mean_x": tr.exact_mean[:1], "exact_mean_y": tr.exact_mean[1:],
         "ekf_mean_x": tr.ekf_mean[:1], "ekf_mean_y": tr.ekf_mean[1:],
         "ekf_bias": np.array([tr.ekf_bias]),
+        # écarts-types (x, y) : ils dépendent de σr comme de σθ (la moyenne, elle, ne dépend que de σθ)
+        "exact_sd": np.sqrt(np.diag(tr.exact_cov)), "ekf_sd": np.sqrt(np.diag(tr.ekf_cov)),
     }
 
 
@@ -66,9 +68,11 @@ def ekf_run(bearing_std_deg: float, range_std: float) -> dict[str, np.ndarray]:
 
 
 def _ekf_readout(series, values) -> str:
+    (sx, sy), (kx, ky) = series["exact_sd"], series["ekf_sd"]
     return (f"Biais de la moyenne de l'EKF : {number(series['ekf_bias'][0], 'm')} ; moyenne exacte de x : "
             f"{number(series['exact_mean_x'][0], 'm')}, alors que l'EKF propage f(x̂) = "
-            f"{number(series['ekf_mean_x'][0], 'm')}.")
+            f"{number(series['ekf_mean_x'][0], 'm')}. Écarts-types de x et de y : exacts {number(sx, 'm')} et "
+            f"{number(sy, 'm')}, EKF {number(kx, 'm')} et {number(ky, 'm')}.")
 
 
 def _plane_glyphs() -> tuple[Glyph, ...]:
@@ -109,7 +113,7 @@ def ekf_spec() -> SliderSpec:
                 x_label="azimut θ (°)",
                 x_range=(-180.0, 180.0),
                 y_range=(-11.0, 11.0),
-                height=220,
+                height=260,  # légende sur quatre lignes sur un téléphone
             ),
         ),
         fixed={"f_x": r_hat * np.cos(np.deg2rad(ANGLES))},

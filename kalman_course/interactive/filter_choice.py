@@ -39,8 +39,10 @@ def _key(name: str) -> str:
 
 def choice_axes() -> tuple[ParameterAxis]:
     r""":math:`\sigma_0 \in \{10, 100, 300, 1000\}` m (défaut 300 m)."""
-    return (ParameterAxis("prior_std", "σ₀", "incertitude initiale de position", "m", np.array(fc.CHOICE_PRIOR_STDS),
-                          default=fc.CHOICE_PRIOR_STDS.index(fc.CHOICE_PRIOR_STD)),)
+    stds = np.array(fc.CHOICE_PRIOR_STDS)
+    labels = tuple(number(s / 1e3, "km") if s >= 1e3 else number(s, "m") for s in stds)  # « 1 km », pas « 1 × 10³ m »
+    return (ParameterAxis("prior_std", "σ₀", "incertitude initiale de position", "m", stds,
+                          default=fc.CHOICE_PRIOR_STDS.index(fc.CHOICE_PRIOR_STD), tick_labels=labels),)
 
 
 def choice_run(prior_std: float) -> dict[str, np.ndarray]:
@@ -56,8 +58,8 @@ def choice_run(prior_std: float) -> dict[str, np.ndarray]:
 
 
 def _readout(series, values) -> str:
-    parts = [f"{name} {number(series[f'{_key(name)}_rmse'][0], 'm', 2)}" for name in fc.CHOICE_FILTERS]
-    return "Erreur quadratique moyenne de position après dix pas : " + ", ".join(parts) + "."
+    parts = [f"{name} {number(series[f'{_key(name)}_rmse'][0], 'm', 3)}" for name in fc.CHOICE_FILTERS]  # comme le tableau
+    return "REQM de position après les dix premiers pas : " + ", ".join(parts) + "."
 
 
 @register_sliders("choix-incertitude", chapter=CHAPTER)
@@ -66,7 +68,8 @@ def choice_spec() -> SliderSpec:
     lo, hi = chi2_band(4, fc.CHOICE_RUNS)
     err = tuple(Glyph(f"{_key(n)}_err", "line", c, n, dash=d) for n, (c, d) in COLORS.items())
     nees = tuple(Glyph(f"{_key(n)}_nees", "line", c, n, dash=d) for n, (c, d) in COLORS.items())
-    band = (Glyph("band_lo", "band", "green", "bande à 95 %", upper="band_hi", alpha=0.2),)
+    # la bande que le texte demande de regarder : aussi visible que les autres surfaces du livre
+    band = (Glyph("band_lo", "band", "green", "bande verte (95 %)", upper="band_hi"),)
     T = TARGET_STEPS
     return SliderSpec(
         name="choix-incertitude",

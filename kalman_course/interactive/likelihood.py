@@ -18,7 +18,7 @@ from ..diagnostics.consistency import whitened_innovations
 from ..likelihood import log_likelihood
 from ..scenarios.nile import local_level_model, nile_fit, nile_run
 from .figure import SliderSpec, number, register_sliders
-from .smoothing import nile_axes
+from .smoothing import UNIT, nile_axes
 from .spec import Follow, Glyph, Panel
 
 __all__ = ["PROFILE_Q", "likelihood_axes", "likelihood_run", "likelihood_spec"]
@@ -60,8 +60,8 @@ def _readout(series, values) -> str:
     R_hat, Q_hat = np.exp(fit.theta)
     v = series["normalised"][np.isfinite(series["normalised"])]
     return (f"log L(R, Q) = {number(series['ll_now'][0], significant=5)} ; maximum "
-            f"{number(fit.log_likelihood, significant=5)} en R̂ = {number(R_hat, significant=5)}, "
-            f"Q̂ = {number(Q_hat, significant=5)}. Innovations normalisées : écart-type {number(v.std())}, "
+            f"{number(fit.log_likelihood, significant=5)} en R̂ = {number(R_hat, UNIT, significant=5)}, "
+            f"Q̂ = {number(Q_hat, UNIT, significant=5)}. Innovations normalisées : écart-type {number(v.std())}, "
             f"{number(100 * np.mean(np.abs(v) > 2), '%')} hors de ±2.")
 
 

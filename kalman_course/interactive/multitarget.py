@@ -3,7 +3,7 @@ r"""Curseurs de la partie « Plusieurs cibles », sur le trafic réel de Toulous
 
 * « Fouillis et association » — la **méthode d'association** (NN, GNN, PDA, JPDA), la **densité du fouillis**
   et la **probabilité de détection** ;
-* « Gérer les pistes » — la **probabilité de la porte**, la densité du fouillis et la **règle de
+* « Gérer les pistes » — la **probabilité de la fenêtre de validation**, la densité du fouillis et la **règle de
   confirmation** « M sur N » (pisteur JPDA).
 
 Les deux figures montrent les pistes confirmées dans le plan, de la couleur de l'avion qu'elles ont suivi
@@ -143,7 +143,7 @@ def association_spec() -> SliderSpec:
 def management_axes() -> tuple[ParameterAxis, ParameterAxis, ParameterAxis]:
     """Probabilité de la porte, densité du fouillis, règle de confirmation (indice dans :data:`CONFIRM_RULES`)."""
     return (
-        ParameterAxis("gate", "P_G", "probabilité de la porte", "", np.array(GATE_PROBABILITIES), default=2,
+        ParameterAxis("gate", "P_G", "probabilité de la fenêtre", "", np.array(GATE_PROBABILITIES), default=2,
                       scale="index", tick_labels=tuple(number(p, significant=4) for p in GATE_PROBABILITIES)),
         _clutter_axis(),
         ParameterAxis("confirm", "M/N", "confirmation : M touches sur N relevés", "",
@@ -163,7 +163,7 @@ def management_spec() -> SliderSpec:
     return SliderSpec(
         name="pistes-curseurs",
         chapter=MANAGEMENT_CHAPTER,
-        title="Gérer les pistes de la scène de Blagnac (JPDA, P_D = 0,9) : porte, fouillis, confirmation M sur N",
+        title="Gérer les pistes de la scène de Blagnac (JPDA, P_D = 0,9) : fenêtre de validation, fouillis, confirmation M sur N",
         x_label="temps (s)",
         axes=management_axes(),
         run=management_run,

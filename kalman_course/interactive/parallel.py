@@ -1,11 +1,12 @@
 r"""Curseurs du chapitre « Filtrer en parallèle dans le temps » : quand le balayage paie-t-il ?
 
-Deux curseurs : le nombre :math:`P` de processeurs qui combinent des éléments en même temps, et le coût
-:math:`c` d'une combinaison (en pas du filtre séquentiel). Le temps du balayage est compté exactement,
-passe par passe : une passe de :math:`w` combinaisons prend :math:`c\lceil w / P\rceil`
+Deux curseurs : le nombre :math:`N_p` de processeurs qui combinent des éléments en même temps (:math:`P`
+reste la covariance), et le coût :math:`c` d'une combinaison (en pas du filtre séquentiel). Le temps du
+balayage est compté exactement, passe par passe : une passe de :math:`w` combinaisons prend
+:math:`c\lceil w / N_p\rceil`
 (:func:`~kalman_course.filters.parallel.associative_scan`) ; le filtre séquentiel prend :math:`T`. Un
 modèle de calcul, pas une mesure : les temps mesurés sont dans la figure ``parallele-temps``. Position par
-défaut : :math:`P = 1`, :math:`c = 2`.
+défaut : :math:`N_p = 1`, :math:`c = 2`.
 """
 
 from __future__ import annotations
@@ -40,14 +41,14 @@ def pass_sizes(T: int) -> list[int]:
 
 
 def scan_time(T: int, processors: int, cost: float) -> float:
-    r"""Temps du balayage avec ``processors`` processeurs : :math:`c\sum_{\text{passes}}\lceil w/P\rceil`."""
+    r"""Temps du balayage avec ``processors`` processeurs : :math:`c\sum_{\text{passes}}\lceil w/N_p\rceil`."""
     return cost * sum(math.ceil(w / processors) for w in pass_sizes(int(T)))
 
 
 def parallel_axes() -> tuple[ParameterAxis, ParameterAxis]:
-    r""":math:`P` (processeurs, défaut 1) et :math:`c` (coût d'une combinaison, défaut 2)."""
+    r""":math:`N_p` (processeurs, défaut 1) et :math:`c` (coût d'une combinaison, défaut 2)."""
     return (
-        ParameterAxis("processors", "P", "processeurs", "", np.array(PROCESSORS, dtype=float), default=0,
+        ParameterAxis("processors", "Nₚ", "processeurs", "", np.array(PROCESSORS, dtype=float), default=0,
                       scale="index", tick_labels=tuple(number(p, significant=6) for p in PROCESSORS)),
         ParameterAxis("cost", "c", "coût d'une combinaison (pas séquentiels)", "", np.array(COSTS), default=1,
                       scale="index", tick_labels=tuple(number(c) for c in COSTS)),
@@ -65,18 +66,19 @@ def parallel_run(processors: float, cost: float) -> dict[str, np.ndarray]:
 def _readout(series, values) -> str:
     P, c = int(round(values[0])), values[1]
     s = series["speedup"]
-    return (f"P = {number(P, significant=6)} processeur(s), une combinaison coûte {number(c)} pas : accélération (temps séquentiel / "
+    processors = "un seul processeur" if P == 1 else f"Nₚ = {number(P, significant=6)} processeurs"
+    return (f"{processors}, une combinaison coûte {number(c)} pas : accélération (temps séquentiel / "
             f"temps du balayage) {number(s[np.searchsorted(LENGTHS, 1000)])} à T = 1 000 et {number(s[-1])} à "
             "T = 10⁶ (au-dessous de 1, le balayage est plus lent).")
 
 
 @register_sliders("parallele-processeurs", chapter=CHAPTER)
 def parallel_spec() -> SliderSpec:
-    """Temps compté du filtre séquentiel et du balayage, selon P et c."""
+    """Temps compté du filtre séquentiel et du balayage, selon Nₚ et c."""
     return SliderSpec(
         name="parallele-processeurs",
         chapter=CHAPTER,
-        title="Quand le balayage paie-t-il ? Temps compté selon le nombre de processeurs P et le coût c d'une combinaison",
+        title="Quand le balayage paie-t-il ? Temps compté selon le nombre de processeurs Nₚ et le coût c d'une combinaison",
         x_label="longueur de la série T (pas)",
         axes=parallel_axes(),
         run=parallel_run,
@@ -84,7 +86,7 @@ def parallel_spec() -> SliderSpec:
         panels=(
             Panel("Temps (en pas du filtre séquentiel)", "temps (pas)",
                   (Glyph("sequential", "line", "firebrick", "filtre séquentiel : T"),
-                   Glyph("parallel", "line", "royalblue", "balayage : c Σ ⌈w/P⌉")),
+                   Glyph("parallel", "line", "royalblue", "balayage : c Σ ⌈w/Nₚ⌉")),
                   y_log=True, x_log=True, x_label="longueur de la série T (pas)", x_range=(10.0, 1e6),
                   y_range=(1.0, 1e8), height=260),
             Panel("Accélération (séquentiel / balayage)", "rapport (sans unité)",

@@ -113,19 +113,29 @@ if (window.kcFigures) window.kcFigures.announce(readout.slice(0, -8));
 
 #: Largeur (px) que l'on peut compter pour une ligne de légende dans la colonne du livre.
 LEGEND_WIDTH = 600
+#: … et sur un téléphone (390 px de large, moins les marges et la barre d'outils) : la légende, dessinée
+#: par Bokeh à taille fixe au-dessus du panneau, y serait coupée ; elle prend autant de lignes qu'il faut
+#: pour tenir dans cette largeur.
+PHONE_LEGEND_WIDTH = 320
+#: Hauteur (px) d'une ligne de légende (9 pt) : un panneau de hauteur fixe grandit d'autant par ligne de
+#: légende ajoutée pour le téléphone, pour garder la même aire de tracé.
+LEGEND_ROW_HEIGHT = 19
 
 
 def _legend_rows(items, width: float = LEGEND_WIDTH) -> int:
-    """Nombre de lignes de la légende pour qu'elle tienne dans ``width`` pixels (la colonne du livre, ou
-    la moitié pour deux panneaux côte à côte ; largeur estimée : 6,3 px par caractère en 9 pt, plus le
-    symbole)."""
+    """Nombre de lignes de la légende pour qu'elle tienne dans ``width`` pixels (la colonne du livre, la
+    moitié pour deux panneaux côte à côte, ou un téléphone). Bokeh range les éléments ligne par ligne dans
+    une grille de ``ceil(n / lignes)`` colonnes, chaque colonne aussi large que son plus long élément
+    (largeur estimée : 6,3 px par caractère en 9 pt, plus le symbole)."""
+    import math
+
     widths = [6.3 * len(item.label.value if hasattr(item.label, "value") else str(item.label)) + 40 for item in items]
-    rows, used = 1, 0.0
-    for w in widths:
-        if used and used + w > width:
-            rows, used = rows + 1, 0.0
-        used += w
-    return rows
+    n = len(widths)
+    for rows in range(1, n + 1):
+        columns = math.ceil(n / rows)
+        if sum(max(widths[c::columns]) for c in range(columns)) <= width:
+            return rows
+    return max(n, 1)
 
 
 def plotted_source_name(length: int, time_length: int) -> str:
@@ -327,13 +337,16 @@ class StaticSliders:
         follow, bounds = [], []
         for p, panel in enumerate(self.panels):
             x_range, y_range = self.ranges_at(p, *grid.default_index)
-            size = {"height": panel.height, "sizing_mode": "stretch_width"}
+            legends = [LegendItem(label=french_spacing(g.legend)) for g in panel.glyphs if g.legend]
+            rows = _legend_rows(legends, min(PHONE_LEGEND_WIDTH, LEGEND_WIDTH / self.columns))
+            extra = rows - _legend_rows(legends, LEGEND_WIDTH / self.columns) if legends else 0
+            size = {"height": panel.height + LEGEND_ROW_HEIGHT * extra, "sizing_mode": "stretch_width"}
             if panel.equal_aspect:
                 # même échelle en x et en y : rapport largeur/hauteur fixé par les bornes
                 ratio = panel.aspect(y_range)
                 size = {"aspect_ratio": ratio, "sizing_mode": "scale_width"}
-                if panel.width is not None:
-                    size = {"width": panel.width, "height": int(round(panel.width / ratio)), "sizing_mode": "fixed"}
+                if panel.width is not None:  # au plus sa largeur (la page la lui donne), moins sur un téléphone
+                    size = {"aspect_ratio": ratio, "sizing_mode": "scale_width", "max_width": panel.width}
             fig = figure(
                 # le titre du panneau est écrit par la page (HTML, il passe à la ligne) : pas dans le canevas
                 tools="pan,box_zoom,wheel_zoom,reset,save",
@@ -350,6 +363,8 @@ class StaticSliders:
             fig.yaxis.axis_label = french_spacing(panel.y_label)
             # graduations en français (virgule décimale, × 10ⁿ), sur les axes linéaires et logarithmiques
             fig.xaxis.formatter = bokeh_tick_formatter(group_thousands=not _is_year_axis(fig.xaxis.axis_label))
+            if self.columns == 2 and not panel.equal_aspect:  # demi-colonne : moins de graduations, lisibles
+                fig.xaxis.ticker.desired_num_ticks = 4
             fig.yaxis.formatter = bokeh_tick_formatter()
             items = []
             for glyph in panel.glyphs:
@@ -361,7 +376,7 @@ class StaticSliders:
                 fig.add_layout(
                     Legend(items=items, orientation="horizontal", location="top_left", label_text_font_size="9pt",
                            border_line_alpha=0, margin=0, padding=2,
-                           nrows=_legend_rows(items, LEGEND_WIDTH / self.columns)),
+                           nrows=rows),
                     "above",
                 )
             figures.append(fig)
@@ -513,10 +528,11 @@ class StaticSliders:
         hint = f" (<code>{html.escape(self.live_hint)}</code>)" if self.live_hint else ""
         # Message visible seulement si BokehJS manque (carnet ouvert dans Jupyter, par exemple) :
         # dans le livre, le script l'efface avant d'insérer la figure.
-        missing = (
+        # (HTML brut : l'extension de typographie du livre ne le voit pas, d'où french_spacing ici)
+        missing = french_spacing(
             "Figure à curseurs précalculés : elle s’affiche dans le livre publié, qui sert BokehJS. "
-            f"Dans Jupyter, utilisez les curseurs interactifs{hint}."
-        )
+            "Dans Jupyter, utilisez les curseurs interactifs"
+        ) + f"{hint}."
         title = italic_latin_html(html.escape(french_spacing(self.title or f"Figure à curseurs « {self.name} »")))
         texts = getattr(self, "_texts", [])
         default = int(np.ravel_multi_index(self.grid.default_index, self.grid.shape))
@@ -530,7 +546,9 @@ class StaticSliders:
                                ensure_ascii=False, separators=(",", ":")).replace("</", "<\\/")
         panels = "".join(
             f'<div class="kc-bokeh-panel{" kc-bokeh-plane" if p.equal_aspect else ""}" id="{root_id}-panel-{k}-box" '
-            f'role="figure" aria-label="{html.escape(self.panel_label(k), quote=True)}">'
+            # un plan de largeur donnée : cette largeur au plus, la colonne entière sur un téléphone
+            + (f'style="flex: 0 1 {p.width}px; max-width: {p.width}px" ' if p.equal_aspect and p.width else "")
+            + f'role="figure" aria-label="{html.escape(self.panel_label(k), quote=True)}">'
             f'<p class="kc-panel-title" aria-hidden="true">{italic_latin_html(html.escape(french_spacing(p.title)))}</p>'
             f'<div class="kc-bokeh-canvas" id="{root_id}-panel-{k}"></div></div>'
             for k, p in enumerate(self.panels)

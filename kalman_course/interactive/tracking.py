@@ -1,9 +1,9 @@
 r"""Curseurs des chapitres de pistage.
 
-* « Plusieurs capteurs, temps irrégulier » — la **porte** (probabilité :math:`p`) et la **densité**
+* « Plusieurs capteurs, temps irrégulier » — la **fenêtre de validation** (probabilité :math:`p`) et la **densité**
   :math:`q` du filtre sur l'hélicoptère SAMU 31, dont six positions ont été corrompues
   (:mod:`kalman_course.scenarios.helicopter`) : la trajectoire estimée et ses ellipses dans le plan, les
-  positions rejetées, la NIS de chaque position et le seuil de la porte.
+  positions rejetées, la NIS de chaque position et le seuil de la fenêtre.
 * « Cibles qui manœuvrent » — le **facteur d'oubli** :math:`\alpha` sur la cible simulée qui vire, et
   l'**IMM** : probabilité de changer de régime et densités des deux régimes
   (:mod:`kalman_course.scenarios.manoeuvre`).
@@ -20,6 +20,7 @@ from ..filters.imm import imm_filter
 from ..filters.kalman import kalman_filter
 from ..scenarios import helicopter as heli
 from ..scenarios import manoeuvre as man
+from ..numbers import format_number
 from .figure import SliderSpec, ellipse_outline, number, register_sliders
 from .grid import ParameterAxis
 from .spec import Follow, Glyph, Panel
@@ -51,18 +52,19 @@ def _joined(curves) -> tuple[np.ndarray, np.ndarray]:
 
 
 def gate_axes() -> tuple[ParameterAxis, ParameterAxis]:
-    """La porte :math:`p` (0,9 à 0,9999, ou aucune) et la densité :math:`q` (0,01 à 10 fois l'apprise)."""
+    """La fenêtre de validation :math:`p` (0,9 à 0,9999, ou aucune) et la densité :math:`q` (0,01 à 10 fois l'apprise)."""
     q_fit = heli.fitted_parameters("position")[0]
     return (
-        ParameterAxis("gate", "p", "probabilité de la porte", "", np.array(GATES), default=2, scale="index",
-                      tick_labels=tuple(number(g, significant=5) for g in GATES[:-1]) + ("sans porte",)),
+        ParameterAxis("gate", "p", "fenêtre de validation", "", np.array(GATES), default=2, scale="index",
+                      tick_labels=tuple(format_number(g, significant=5, trim=True) for g in GATES[:-1])
+                      + ("sans fenêtre",)),
         ParameterAxis("q", "q", "densité d'accélération", "m²/s³", q_fit * np.array(Q_FACTORS),
                       default=Q_FACTORS.index(1.0)),
     )
 
 
 def gate_run(gate: float, q: float) -> dict[str, np.ndarray]:
-    """Le filtre (positions seules, six positions corrompues) avec la porte ``gate`` (1 : aucune) et la
+    """Le filtre (positions seules, six positions corrompues) avec la fenêtre ``gate`` (1 : aucune) et la
     densité ``q`` : estimation, ellipses à 2σ, positions rejetées, NIS et seuil."""
     track = heli.helicopter_track("position")
     sp = heli.fitted_parameters("position")[1]
@@ -89,35 +91,54 @@ def _gate_readout(series, values) -> str:
     lost = series["lost"][0]
     where = "jamais perdue" if np.isnan(lost) else f"perdue à t = {number(lost, 's')}"
     return (f"Positions rejetées : {int(series['n_rejected'][0])} sur 278, dont {int(series['n_outliers'][0])} "
-            f"des 6 aberrantes ; erreur de prédiction (moyenne quadratique) : {number(series['rms'][0], 'm')} ; "
+            f"des 6 aberrantes ; REQM de prédiction des positions : {number(series['rms'][0], 'm')} ; "
             f"piste {where}.")
+
+
+#: Agrandissement : les deux positions aberrantes consécutives (lignes 80 et 81 de :data:`~.helicopter.OUTLIER_ROWS`),
+#: à ± ``ZOOM_HALF_WIDTH`` km en est.
+ZOOM_ROWS, ZOOM_HALF_WIDTH = (1, 2), 0.35
 
 
 @register_sliders("capteurs-porte-curseurs", chapter=SENSORS_CHAPTER)
 def gate_spec() -> SliderSpec:
-    """La porte et la densité, au curseur, sur l'hélicoptère aux six positions corrompues."""
+    """La fenêtre de validation et la densité, au curseur, sur l'hélicoptère aux six positions corrompues ;
+    un agrandissement montre le crochet de l'estimation vers deux positions aberrantes consécutives."""
     track = heli.helicopter_track("position")
     y = heli.with_outliers(track)
     bad = np.flatnonzero(track.position_rows)[list(heli.OUTLIER_ROWS)]
     e, n = np.asarray(track.y)[:, 0] / 1e3, np.asarray(track.y)[:, 1] / 1e3
+    zoom = np.asarray(track.y)[bad[list(ZOOM_ROWS)], :2].mean(axis=0) / 1e3
+    def plane(zoom: bool) -> tuple[Glyph, ...]:
+        """Les tracés du plan ; dans l'agrandissement, coupés par son cadre et sans légende (la même)."""
+        def name(text: str) -> str:
+            return "" if zoom else text
+        return (
+            Glyph("meas_n", "scatter", "gray", name("positions mesurées"), x="meas_e", marker="cross", size=5,
+                  clip=zoom),
+            Glyph("ell_n", "line", "royalblue", name("ellipses à 2σ"), x="ell_e", width=1.0, alpha=0.7, clip=zoom),
+            Glyph("est_n", "line", "darkorange", name("estimation"), x="est_e", width=1.8, clip=zoom),
+            Glyph("rej_n", "scatter", "black", name("positions rejetées"), x="rej_e", marker="circle", size=9,
+                  clip=zoom),
+            Glyph("out_n", "scatter", "crimson", name("positions aberrantes"), x="out_e", marker="x", size=11,
+                  clip=zoom),
+        )
     return SliderSpec(
         name="capteurs-porte-curseurs",
         chapter=SENSORS_CHAPTER,
-        title="Hélicoptère SAMU 31, six positions corrompues : porte p et densité q du filtre",
+        title="Hélicoptère SAMU 31, six positions corrompues : fenêtre de validation p et densité q du filtre",
         x_label="temps (s)",
         axes=gate_axes(),
         run=gate_run,
         time=np.asarray(track.t),
         panels=(
-            Panel("Estimation, ellipses à 2σ (une sur six)", "nord (km)", (
-                Glyph("meas_n", "scatter", "gray", "positions mesurées", x="meas_e", marker="cross", size=5),
-                Glyph("out_n", "scatter", "crimson", "positions aberrantes", x="out_e", marker="x", size=11),
-                Glyph("ell_n", "line", "royalblue", "ellipses à 2σ", x="ell_e", width=1.0, alpha=0.7),
-                Glyph("est_n", "line", "darkorange", "estimation", x="est_e", width=1.8),
-                Glyph("rej_n", "scatter", "black", "positions rejetées", x="rej_e", marker="circle", size=7),
-            ), x_label="est (km)", x_range=(-1.5, 5.5), y_range=Follow(aspect=7.0 / 7.8, margin=0.04),
-                equal_aspect=True, width=400, height=370),  # une piste perdue part loin : le plan la suit
-            Panel("NIS de chaque position et seuil de la porte", "NIS (sans unité)", (
+            Panel("Estimation, ellipses à 2σ (une sur six)", "nord (km)", plane(False),
+                  x_label="est (km)", x_range=(-1.5, 5.5), y_range=Follow(aspect=7.0 / 7.8, margin=0.04),
+                  equal_aspect=True, width=400, height=370),  # une piste perdue part loin : le plan la suit
+            Panel("Agrandissement : deux positions aberrantes consécutives", "nord (km)", plane(True),
+                  x_label="est (km)", x_range=(zoom[0] - ZOOM_HALF_WIDTH, zoom[0] + ZOOM_HALF_WIDTH),
+                  y_range=(zoom[1] - 0.3, zoom[1] + 0.3), equal_aspect=True, width=400, height=340),
+            Panel("NIS de chaque position et seuil de la fenêtre", "NIS (sans unité)", (
                 Glyph("nis", "scatter", "darkorange", "NIS", marker="dot", size=6),
                 Glyph("threshold", "line", "black", "seuil χ²₂(p)", dash="dashed", width=1.5),
             ), y_log=True, y_range=(1e-4, 1e6), height=220),
@@ -158,7 +179,7 @@ def fading_run(alpha: float) -> dict[str, np.ndarray]:
 
 def _fading_readout(series, values) -> str:
     straight, turn = series["rms"]
-    return (f"Erreur quadratique moyenne de position : {number(straight, 'm')} en ligne droite, "
+    return (f"REQM de position : {number(straight, 'm')} en ligne droite, "
             f"{number(turn, 'm')} dans les virages (et les 10 s qui suivent).")
 
 
@@ -170,10 +191,14 @@ def _plane_glyphs(estimate_legend: str) -> tuple[Glyph, ...]:
     )
 
 
+#: Hauteur (m) des surfaces « virages » : bien au-delà de l'axe, elles le couvrent en entier (tracé ``clip``).
+TURN_BAND = 1e5
+
+
 def _example_fixed() -> dict[str, np.ndarray]:
     st = man.manoeuvre_example()
     return {"true_e": st.truth[:, 0] / 1e3, "true_n": st.truth[:, 1] / 1e3, "meas_e": st.y[:, 0] / 1e3,
-            "meas_n": st.y[:, 1] / 1e3, "turn": 120.0 * (man.turn_rate_profile(st.t - man.DT) != 0)}
+            "meas_n": st.y[:, 1] / 1e3, "turn": TURN_BAND * (man.turn_rate_profile(st.t - man.DT) != 0)}
 
 
 _PLANE = dict(x_label="est (km)", x_range=(-0.3, 3.3), y_range=(-0.3, 3.7), equal_aspect=True, width=400,
@@ -195,7 +220,7 @@ def fading_spec() -> SliderSpec:
         panels=(
             Panel("Dans le plan", "nord (km)", _plane_glyphs("estimation avec oubli"), **_PLANE),
             Panel("Erreur de position et son 2σ annoncé", "erreur (m)", (
-                Glyph("turn", "area", "gray", "virages", alpha=0.6),
+                Glyph("turn", "area", "gray", "virages", alpha=0.6, clip=True),  # toute la hauteur
                 Glyph("sd", "line", "royalblue", "2σ annoncé", dash="dashed", width=1.5),
                 Glyph("err", "line", "darkorange", "erreur de position", width=1.6),
             ), y_log=False, y_range=Follow(include=(0.0,)), height=230),  # sans oubli, l'erreur passe 120 m
@@ -239,7 +264,7 @@ def imm_run(switch: float, q_quiet: float, q_manoeuvre: float) -> dict[str, np.n
 
 def _imm_readout(series, values) -> str:
     straight, turn = series["rms"]
-    return (f"Erreur quadratique moyenne de position : {number(straight, 'm')} en ligne droite, "
+    return (f"REQM de position : {number(straight, 'm')} en ligne droite, "
             f"{number(turn, 'm')} dans les virages ; probabilité moyenne du régime agité "
             f"{number(float(np.mean(series['mu'])), significant=2)}.")
 

@@ -30,18 +30,21 @@ from .grading import Case, Exercise, Mistake, Output, grade
 from .linear import JOSEPH_UPDATE, KF_PREDICT, KF_UPDATE, NIS
 from .multitarget import PDA_UPDATE, PDA_WEIGHTS
 from .nonlinear import EKF_UPDATE, SO3_EXP, TAG_JACOBIAN
+from .invariant import SE2_EXP, SE2_INVARIANT_PREDICT, SE2_INVARIANT_UPDATE
 from .sampling import PARTICLE_WEIGHTS, SIGMA_POINTS, SYSTEMATIC_RESAMPLE, UNSCENTED_TRANSFORM
 from .smoothing import EM_M_STEP, RTS_STEP
+from .tracking import CV_MODEL, IMM_MERGE, IMM_MIX, MODE_PROBABILITIES, NIS_GATE, VAN_LOAN
 from .verdict import Verdict
 
 __all__ = ["Attempt", "Case", "Exercise", "Mistake", "Output", "Verdict", "attempt", "check", "exercise", "exercises",
-           "exercise_table"]
+           "exercise_table", "validated", "wheel_name"]
 
 _EXERCISES: tuple[Exercise, ...] = (
     KF_PREDICT, KF_UPDATE, JOSEPH_UPDATE, NIS,
-    EKF_UPDATE, TAG_JACOBIAN, SO3_EXP,
+    EKF_UPDATE, TAG_JACOBIAN, SO3_EXP, SE2_EXP, SE2_INVARIANT_PREDICT, SE2_INVARIANT_UPDATE,
     SIGMA_POINTS, UNSCENTED_TRANSFORM, SYSTEMATIC_RESAMPLE, PARTICLE_WEIGHTS,
     RTS_STEP, EM_M_STEP,
+    CV_MODEL, VAN_LOAN, NIS_GATE, IMM_MIX, MODE_PROBABILITIES, IMM_MERGE,
     PDA_WEIGHTS, PDA_UPDATE,
 )
 _BY_ID = {ex.id: ex for ex in _EXERCISES}
@@ -97,19 +100,47 @@ class Attempt(NamedTuple):
     message: str | None
 
 
+def wheel_name() -> str:
+    """Le nom de la roue du paquet servie par le site (``kalman_course-<version>-py3-none-any.whl``) : la
+    version est celle du paquet installé (``pyproject.toml``)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        number = version("kalman_course")
+    except PackageNotFoundError:  # pragma: no cover — paquet lu depuis le dépôt sans installation
+        number = "0.1.0"
+    return f"kalman_course-{number}-py3-none-any.whl"
+
+
+def validated(exercise_id: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+    """La fonction ``fn`` de l'étudiant pour l'exercice ``exercise_id``, dont chaque résultat est vérifié
+    (nombre et nature des sorties) : à passer aux expériences des TP, pour qu'un ``return`` oublié soit
+    reproché à la fonction de l'étudiant (voir :func:`attempt`)."""
+    from .grading import validated as _validated
+
+    return _validated(exercise(exercise_id), fn)
+
+
 def attempt(run: Callable[[], Any], time_limit: float = 120.0) -> Attempt:
     """Lance ``run()`` — une expérience qui appelle les fonctions de l'étudiant (son filtre sur les
     données d'un TP) — sans jamais lever : une exception devient un message en français qui nomme la
     ligne en cause (« pas encore écrite » pour un squelette)."""
-    from .grading import exception_text
+    from .grading import StudentResultError, exception_text
     from .student import call
 
-    outcome = call(run, (), time_limit)
+    outcome = call(run, (), time_limit, fallback=False)
     if outcome.timed_out:
         return Attempt(None, f"votre code n'a pas rendu la main après {time_limit:g} s")
     if outcome.error is None:
         return Attempt(outcome.value, None)
-    where = f" ({outcome.place.describe()})" if outcome.place is not None else ""
+    if isinstance(outcome.error, StudentResultError):
+        return Attempt(None, str(outcome.error))
     if isinstance(outcome.error, NotImplementedError):
+        where = f" ({outcome.place.describe()})" if outcome.place is not None else ""
         return Attempt(None, f"fonction pas encore écrite{where}")
-    return Attempt(None, exception_text(outcome.error) + where)
+    if outcome.place is None:  # l'erreur est née dans le paquet, sur un résultat de l'étudiant
+        error = outcome.error
+        detail = f"`{type(error).__name__}: {error}`" if str(error) else f"`{type(error).__name__}`"
+        return Attempt(None, f"le résultat d'une de vos fonctions n'a pas pu servir au filtre (Python : {detail}) : "
+                             f"vérifiez la forme de ce qu'elles renvoient (le correcteur de chacune le dit)")
+    return Attempt(None, exception_text(outcome.error) + f" ({outcome.place.describe()})")

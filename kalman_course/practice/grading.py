@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import inspect
+import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -24,7 +25,8 @@ from . import student
 from .student import Outcome, Place, StudentSource, call, source_of
 from .verdict import Verdict
 
-__all__ = ["Case", "Exercise", "Mistake", "Output", "grade", "close", "exception_text"]
+__all__ = ["Case", "Exercise", "Mistake", "Output", "StudentResultError", "grade", "close", "exception_text",
+           "validated"]
 
 #: Tolérance relative des comparaisons (une inverse au lieu d'une résolution reste juste).
 RTOL = 1e-6
@@ -71,7 +73,12 @@ class Mistake:
     les sorties de l'étudiant sont celles d'``example`` : toutes (reconnaissance complète), ou
     seulement celles d'indices ``outputs`` si elles diffèrent bien de la référence (reconnaissance
     partielle : l'étudiant a pu faire une autre erreur sur les autres sorties). ``culprit`` : motifs (expressions rationnelles) de la ligne fautive
-    typique ; ``output`` : la sortie en cause (pour nommer la ligne qui la calcule)."""
+    typique ; ``output`` : la sortie en cause (pour nommer la ligne qui la calcule). Une ligne trouvée par
+    ``culprit`` n'est nommée que si elle porte la trace de l'erreur : elle correspond à chaque motif de
+    ``confirm`` et à aucun de ``refute`` (sinon le verdict donne l'explication sans nommer de ligne).
+
+    Une erreur n'est reconnue que si elle explique la fonction de l'étudiant sur **tous** les cas cachés :
+    aucun cas où l'étudiant a juste et où l'implémentation fausse se tromperait (voir :func:`grade`)."""
 
     id: str
     title: str
@@ -82,11 +89,13 @@ class Mistake:
     outputs: tuple[int, ...] | None = None
     culprit: tuple[str, ...] = ()
     output: int = 0
+    confirm: tuple[str, ...] = ()
+    refute: tuple[str, ...] = ()
 
     def matches(self, outputs: tuple, case: Case) -> int:
         """Les sorties de l'étudiant sur ``case`` sont-elles celles de cette erreur ? 2 : toutes (ou le
         détecteur le dit) ; 1 : celles d'indices ``outputs``, qui diffèrent de la référence ; 0 : non."""
-        if self.exception is not None:
+        if self.exception is not None and self.detect is None:
             return 0
         if self.detect is not None:
             try:
@@ -110,6 +119,24 @@ class Mistake:
         except (TypeError, ValueError, IndexError):
             pass
         return 0
+
+    def wrong_on(self, case: Case, partial: bool) -> bool | None:
+        """L'implémentation fausse (``example``) se trompe-t-elle sur ``case`` ? Pour une reconnaissance
+        partielle, seules les sorties d'indices ``outputs`` comptent. ``None`` si on ne peut pas le dire
+        (elle lève, ou sa sortie n'est pas un tableau)."""
+        outcome = call(self.example, tuple(copy.deepcopy(a) for a in case.args))
+        if not outcome.ok:
+            return None
+        k = len(case.expected)
+        wrong = outcome.value if k > 1 else (outcome.value,)
+        try:
+            wrong = tuple(np.asarray(w, dtype=float) for w in wrong)
+            if len(wrong) != k:
+                return True
+            indices = self.outputs if partial and self.outputs else range(k)
+            return any(not close(wrong[i], case.expected[i]) for i in indices)
+        except (TypeError, ValueError, IndexError):
+            return None
 
 
 @dataclass(frozen=True)
@@ -189,8 +216,7 @@ def exception_text(exc: BaseException, ex: Exercise | None = None) -> str:
     ):
         hint = f" Rappel des formes : {ex.shapes_hint}." if ex is not None and ex.shapes_hint else ""
         return (f"Dimensions incompatibles : un produit ou une somme de tableaux de formes qui ne vont "
-                f"pas ensemble (un vecteur ligne, une transposée en trop ou en moins, `*` au lieu de `@` ?)."
-                f"{hint} (Python : {original}.)")
+                f"pas ensemble. Écrivez la forme de chaque terme de la ligne en cause.{hint} (Python : {original}.)")
     if isinstance(exc, TypeError) and "function" in message:
         return (f"Une fonction est utilisée comme un tableau : appelez-la d'abord sur un point, par "
                 f"exemple `h(x_pred)`. (Python : {original}.)")
@@ -292,9 +318,10 @@ def _structure_problem(ex: Exercise, outs: tuple, case: Case, source: StudentSou
         if output.kind == "covariance" and arr.ndim == 2:
             scale = max(1.0, float(np.abs(arr).max()))
             if np.abs(arr - arr.T).max() > 1e-8 * scale:
-                return _fail(ex, "valeur", f"La covariance « {output.name} » n'est pas symétrique : une "
-                                            f"covariance l'est toujours. Une transposée oubliée ?",
-                             place, case=(number, case))
+                return _fail(ex, "valeur", f"La covariance « {output.name} » n'est pas symétrique, alors qu'une "
+                                            f"covariance l'est toujours : chaque terme qui la forme doit être "
+                                            f"symétrique (M P Mᵀ, covariance). Vérifiez-les un à un, en dimension "
+                                            f"n ≥ 2.", place, case=(number, case))
         if output.kind == "indices" and not np.array_equal(arr, np.round(arr)):
             return _fail(ex, "valeur", f"« {output.name} » doit contenir des indices entiers.", place,
                          case=(number, case))
@@ -317,9 +344,78 @@ def _value_problem(ex: Exercise, outs: tuple, case: Case, source: StudentSource 
 
 
 def _mistake_place(mistake: Mistake, source: StudentSource | None, k: int) -> Place | None:
+    """La ligne à nommer pour ``mistake``, seulement si elle est sûre : la ligne typique de l'erreur
+    (``culprit``) quand elle en porte la trace (``confirm``, ``refute``) ; sinon, pour une erreur sans motif
+    de ligne, celle qui calcule la sortie en cause ; sinon aucune."""
     if source is None:
         return None
-    return source.find(mistake.culprit) or source.output_place(mistake.output, k)
+    if mistake.culprit:
+        place = source.find(mistake.culprit)
+        if place is None:
+            return None
+        code = place.text.split("#", 1)[0]
+        sure = all(re.search(p, code) for p in mistake.confirm) and not any(re.search(p, code) for p in mistake.refute)
+        return place if sure else None
+    return source.output_place(mistake.output, k)
+
+
+def _student_outputs(ex: Exercise, fn: Callable, case: Case, source: StudentSource | None) -> tuple | None:
+    """Les sorties de l'étudiant sur ``case`` (tableaux), ou ``None`` si l'appel échoue."""
+    outcome = call(fn, tuple(copy.deepcopy(a) for a in case.args))
+    if not outcome.ok:
+        return None
+    try:
+        return _outputs(ex, outcome.value, source)
+    except _Stop:
+        return None
+
+
+def _recognise(ex: Exercise, fn: Callable, source: StudentSource | None, cases: list[Case], number: int,
+               outs: tuple) -> Mistake | None:
+    """L'erreur classique qui explique la fonction de l'étudiant, ou ``None``.
+
+    Candidates : les erreurs dont la sortie coïncide avec celle de l'étudiant sur le premier cas qui échoue
+    (le cas n° ``number``). Une candidate est écartée dès qu'un autre cas la contredit : l'étudiant y a juste
+    alors que l'implémentation fausse s'y tromperait (et que le détecteur de l'erreur, qui connaît ses
+    variantes, ne reconnaît pas la sortie de l'étudiant) (une erreur dans une seule branche du code de
+    l'étudiant — petits angles, n = 1 — n'est pas prise pour une erreur de la formule générale). Parmi les
+    autres : la reconnaissance complète d'abord, puis celle qui explique le plus de cas faux, puis l'ordre de
+    déclaration."""
+    case = cases[number - 1]
+    scores = [m.matches(outs, case) for m in ex.mistakes]
+    if not any(scores):
+        return None
+    others = []
+    for j, c in enumerate(cases, 1):
+        if j == number:
+            continue
+        theirs = _student_outputs(ex, fn, c, source)
+        if theirs is None:
+            continue
+        right = all(close(o, e) for o, e in zip(theirs, c.expected)) if ex.judge is None \
+            else ex.judge(theirs, c) is None
+        others.append((c, theirs, right))
+    best, best_key = None, None
+    for order, (mistake, score) in enumerate(zip(ex.mistakes, scores)):
+        if not score:
+            continue
+        explained = 1
+        contradicted = False
+        for c, theirs, right in others:
+            agrees = mistake.matches(theirs, c) > 0
+            if right:
+                # juste ici, alors que l'erreur se tromperait (et que sa variante reconnue ne l'explique pas)
+                if not agrees and mistake.wrong_on(c, partial=score == 1):
+                    contradicted = True
+                    break
+            elif agrees:
+                explained += 1
+        if contradicted:
+            continue
+        key = (score, explained, -order)
+        if best_key is None or key > best_key:
+            best, best_key = mistake, key
+    return best
 
 
 def _judge(ex: Exercise, fn: Callable, source: StudentSource | None, names: list[str]) -> Verdict:
@@ -328,6 +424,8 @@ def _judge(ex: Exercise, fn: Callable, source: StudentSource | None, names: list
     for number, case in enumerate(cases, 1):
         args = tuple(copy.deepcopy(a) for a in case.args)
         outcome: Outcome = call(fn, args)
+        if source is not None:
+            source.follow(outcome)
         if outcome.timed_out:
             raise _Stop(_fail(ex, "temps", f"Votre fonction n'a pas rendu la main après {student.TIME_LIMIT:g} s : une boucle sans fin ?",
                               None, case=(number, case)))
@@ -372,12 +470,10 @@ def _judge(ex: Exercise, fn: Callable, source: StudentSource | None, names: list
             message = None
         if correct:
             continue
-        scores = [mistake.matches(outs, case) for mistake in ex.mistakes]
-        for score in (2, 1):
-            mistake = next((m for m, s in zip(ex.mistakes, scores) if s == score), None)
-            if mistake is not None:
-                raise _Stop(_fail(ex, "erreur classique", f"Erreur classique : {mistake.title}.\n{mistake.hint}",
-                                  _mistake_place(mistake, source, k), mistake.id, (number, case)))
+        mistake = _recognise(ex, fn, source, cases, number, outs)
+        if mistake is not None:
+            raise _Stop(_fail(ex, "erreur classique", f"Erreur classique : {mistake.title}.\n{mistake.hint}",
+                              _mistake_place(mistake, source, k), mistake.id, (number, case)))
         structure = _structure_problem(ex, outs, case, source, number)
         if structure is not None:
             raise _Stop(structure)
@@ -389,6 +485,32 @@ def _judge(ex: Exercise, fn: Callable, source: StudentSource | None, names: list
     return Verdict(ex.id, ex.title, True,
                    f"Bravo : votre fonction donne le bon résultat sur les {len(cases)} cas cachés :\n{labels}",
                    "réussi")
+
+
+class StudentResultError(Exception):
+    """Levée par une fonction de l'étudiant enveloppée par :func:`validated` quand son résultat n'a pas la
+    forme de l'exercice (rien, trop de valeurs, pas des nombres) ; le message, en français, nomme sa ligne."""
+
+
+def validated(ex: Exercise, fn: Callable) -> Callable:
+    """``fn`` (une fonction de l'étudiant pour l'exercice ``ex``) dont le résultat est vérifié à chaque appel :
+    rendu en tableaux ``float`` (un tuple s'il y a plusieurs sorties) ; un résultat sans la forme attendue
+    lève :class:`StudentResultError`, qui nomme la fonction et sa ligne (et non le code du paquet qui
+    l'appelle)."""
+    source = source_of(fn)
+    name = getattr(fn, "__name__", "votre fonction")
+
+    def checked(*args):
+        value = fn(*args)
+        try:
+            outs = _outputs(ex, value, source)
+        except _Stop as stop:
+            lines = stop.verdict.feedback.split("\n")
+            raise StudentResultError(f"`{name}` : " + " ".join(lines)) from None
+        return outs if len(outs) > 1 else outs[0]
+
+    checked.__name__ = name
+    return checked
 
 
 def grade(ex: Exercise, fn: Any) -> Verdict:

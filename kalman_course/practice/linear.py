@@ -7,6 +7,8 @@ documentée par l'implémentation fausse qu'écrirait un étudiant.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from ..core.models import LinearGaussianModel
@@ -199,6 +201,30 @@ def _update_joseph_incomplete(x_pred, P_pred, y, C, R):
     return x, P
 
 
+def _update_identity_size(x_pred, P_pred, y, C, R):
+    S = C @ P_pred @ C.T + R
+    K = P_pred @ C.T @ np.linalg.inv(S)
+    x = x_pred + K @ (y - C @ x_pred)
+    P = (np.eye(len(y)) - K @ C) @ P_pred
+    return x, P
+
+
+def _identity_size_error(exc: BaseException, line: str) -> bool:
+    """``np.eye(m) - K @ C`` (identité de la taille de la mesure) : numpy ne peut pas diffuser (m, m) sur (n, n)."""
+    code = line.split("#", 1)[0]
+    return isinstance(exc, ValueError) and "broadcast" in str(exc) and re.search(r"eye\(", code) is not None \
+        and re.search(r"eye\(\s*(len\(\s*y|y\.|m\b|C\.shape\[0\]|R\.shape)", code) is not None
+
+
+def _detect_identity_size(outs, case):
+    """Mesure scalaire (m = 1) : ``np.eye(1) - K @ C`` est diffusée, élément par élément, en ``1 − K C``."""
+    x_pred, P_pred, y, C, R = case.args
+    if y.shape[0] != 1 or x_pred.shape[0] == 1:
+        return False
+    wrong = _update_identity_size(*case.args)
+    return close(outs[1], wrong[1]) and not close(wrong[1], case.expected[1])
+
+
 def _update_p_not_updated(x_pred, P_pred, y, C, R):
     S = C @ P_pred @ C.T + R
     K = P_pred @ C.T @ np.linalg.inv(S)
@@ -221,11 +247,11 @@ KF_UPDATE = Exercise(
         Mistake("gain-r", "gain P Cᵀ R⁻¹ au lieu de P⁻ Cᵀ S⁻¹",
                 "Le gain divise par la covariance de l'innovation S = C P⁻ Cᵀ + R, pas par R seule : "
                 "K = P⁻ Cᵀ S⁻¹. (La forme K = P⁺ Cᵀ R⁻¹ existe, mais avec la covariance a posteriori P⁺.)",
-                _update_gain_r, culprit=_GAIN_LINE),
+                _update_gain_r, culprit=_GAIN_LINE, confirm=(r"\bR",), refute=(r"\bS\b",)),
         Mistake("p-before-k", "P mise à jour avant de calculer K",
                 "K = P⁻ Cᵀ S⁻¹ se calcule avec la covariance prédite P⁻ : si P est déjà remplacée par P⁺ quand "
                 "vous calculez K, le gain est faux. Calculez S, puis K, puis x et enfin P.",
-                _update_p_before_k, outputs=(0,), culprit=_GAIN_LINE),
+                _update_p_before_k, outputs=(0,), culprit=_GAIN_LINE, confirm=(r"\bP\b",)),
         Mistake("innovation-sign", "innovation C x⁻ − y au lieu de y − C x⁻",
                 "L'innovation est la mesure moins sa prédiction : ν = y − C x⁻. Avec le signe opposé, la "
                 "correction éloigne l'estimation de la mesure.",
@@ -233,11 +259,11 @@ KF_UPDATE = Exercise(
         Mistake("s-without-r", "S = C P⁻ Cᵀ (R oubliée)",
                 "La covariance de l'innovation contient le bruit de mesure : S = C P⁻ Cᵀ + R. Sans R, le filtre "
                 "croit la mesure parfaite et recopie y.",
-                _update_s_without_r, culprit=(r"^\s*S\w*\s*=",)),
+                _update_s_without_r, culprit=(r"^\s*S\w*\s*=",), refute=(r"\bR\b",)),
         Mistake("no-inverse", "S non inversée dans le gain",
                 "K = P⁻ Cᵀ S⁻¹ : il faut diviser par S (`np.linalg.solve(S, C @ P_pred).T`, ou `@ np.linalg.inv(S)`), "
                 "pas multiplier.",
-                _update_no_inverse, culprit=_GAIN_LINE),
+                _update_no_inverse, culprit=_GAIN_LINE, refute=(r"inv|solve|/|lstsq",)),
         Mistake("joseph-incomplete", "forme de Joseph sans le terme K R Kᵀ",
                 "La forme de Joseph est P = (I − K C) P⁻ (I − K C)ᵀ + K R Kᵀ : le dernier terme (le bruit de "
                 "la mesure qui entre par le gain) est indispensable. Ou bien la forme courte P = (I − K C) P⁻.",
@@ -246,6 +272,13 @@ KF_UPDATE = Exercise(
                 "Une mesure apporte de l'information : P = (I − K C) P⁻ est plus petite que P⁻. Votre fonction "
                 "renvoie P⁻ telle quelle.",
                 _update_p_not_updated, outputs=(1,), output=1),
+        Mistake("identity-size", "identité de la taille de la mesure au lieu de celle de l'état",
+                "Dans P = (I − K C) P⁻, K C est une matrice (n, n) : l'identité est celle de l'état, "
+                "`np.eye(len(x_pred))`, pas `np.eye(len(y))`. Avec une mesure scalaire, numpy diffuse "
+                "silencieusement `np.eye(1) - K @ C` en 1 − K C élément par élément ; sinon les formes ne vont pas "
+                "ensemble.",
+                _update_identity_size, detect=_detect_identity_size, exception=_identity_size_error,
+                culprit=(r"eye\(\s*(len\(\s*y|y\.|m\b|C\.shape\[0\]|R\.shape)",), output=1),
     ),
 )
 
@@ -336,7 +369,7 @@ JOSEPH_UPDATE = Exercise(
         Mistake("recomputed-gain", "gain optimal recalculé au lieu du gain K donné",
                 "L'exercice donne le gain K (par exemple un gain fixe, ou le gain d'un filtre mal réglé) : "
                 "utilisez-le tel quel, ne recalculez pas P⁻ Cᵀ S⁻¹.",
-                _joseph_recomputed_gain, culprit=_GAIN_LINE),
+                _joseph_recomputed_gain, culprit=_GAIN_LINE, confirm=(r"\bC\b",)),
     ),
 )
 

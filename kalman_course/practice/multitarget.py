@@ -46,21 +46,21 @@ def _weights_cases() -> list[Case]:
     S2 = np.array([[400.0, 120.0], [120.0, 250.0]])
     L2 = np.linalg.cholesky(S2)
     cases = [
-        _weights_case("m = 2, deux détections dans la porte", (L2 @ np.array([[0.5, -0.3], [-1.2, 1.0]]).T).T,
+        _weights_case("m = 2, deux détections dans la fenêtre", (L2 @ np.array([[0.5, -0.3], [-1.2, 1.0]]).T).T,
                       S2, 0.9, 1e-4, 0.99),
-        _weights_case("m = 2, une détection sur trois hors de la porte",
+        _weights_case("m = 2, une détection sur trois hors de la fenêtre",
                       (L2 @ np.array([[0.3, 0.8], [5.0, 1.0], [-1.0, -1.4]]).T).T, S2, 0.8, 5e-5, 0.99),
         _weights_case("m = 1, quatre détections, fouillis dense", np.array([[0.4], [-1.5], [2.2], [0.9]]),
                       np.array([[1.5]]), 0.7, 0.8, 0.95),
         _weights_case("N = 0 : un relevé vide (innovations de forme (0, 2))", np.empty((0, 2)), S2, 0.9, 1e-4, 0.99),
         _weights_case("P_D = 1 : une cible toujours détectée", (L2 @ np.array([[0.2, 0.1], [1.5, -1.0]]).T).T, S2,
                       1.0, 2e-4, 0.99),
-        _weights_case("aucune détection dans la porte", (L2 @ np.array([[6.0, 0.0], [0.0, -7.0]]).T).T, S2, 0.9,
+        _weights_case("aucune détection dans la fenêtre", (L2 @ np.array([[6.0, 0.0], [0.0, -7.0]]).T).T, S2, 0.9,
                       1e-4, 0.99),
     ]
     S3 = spd(rng, 3, 50.0)
     nu3 = (np.linalg.cholesky(S3) @ rng.normal(0.0, 1.2, (5, 3)).T).T
-    cases.append(_weights_case("m = 3, cinq détections, porte étroite (P_G = 0,9)", nu3, S3, 0.85, 1e-3, 0.9))
+    cases.append(_weights_case("m = 3, cinq détections, fenêtre étroite (P_G = 0,9)", nu3, S3, 0.85, 1e-3, 0.9))
     return cases
 
 
@@ -139,7 +139,7 @@ PDA_WEIGHTS = Exercise(
     mistakes=(
         Mistake("no-missed", "hypothèse « aucune détection » oubliée",
                 "Il y a N + 1 hypothèses : aucune des détections ne vient de la cible (poids 1 − P_D P_G : elle n'a "
-                "pas été détectée, ou hors de la porte), ou c'est la détection j. Sans la première, la piste croit "
+                "pas été détectée, ou hors de la fenêtre), ou c'est la détection j. Sans la première, la piste croit "
                 "toujours qu'une détection est la bonne, même quand toutes viennent du fouillis.",
                 _pw_no_missed, detect=_detect_no_missed, culprit=(r"/\s*\(?\s*\w+\.sum\(", r"/\s*np\.sum\(")),
         Mistake("not-normalised", "poids non normalisés",
@@ -151,12 +151,12 @@ PDA_WEIGHTS = Exercise(
                 "vraisemblance de la cible, la densité du fouillis la divise (une détection est d'autant moins "
                 "crédible que le fouillis est dense). Vous avez écrit λ N / P_D.",
                 _pw_swapped, culprit=(r"(clutter_density|lam\w*)\s*\*", r"/\s*(detection_probability|p_?d)\b")),
-        Mistake("no-gate", "détections hors de la porte gardées",
-                "Seules les détections de la porte, NIS νᵀ S⁻¹ ν ≤ γ = χ²_m(P_G) (`scipy.stats.chi2.ppf(P_G, m)`), "
-                "ont un poids ; les autres ont β = 0. Le poids 1 − P_D P_G suppose cette porte.",
+        Mistake("no-gate", "détections hors de la fenêtre gardées",
+                "Seules les détections de la fenêtre, NIS νᵀ S⁻¹ ν ≤ γ = χ²_m(P_G) (`scipy.stats.chi2.ppf(P_G, m)`), "
+                "ont un poids ; les autres ont β = 0. Le poids 1 − P_D P_G suppose cette fenêtre.",
                 _pw_no_gate),
         Mistake("missed-1-pd", "poids de « aucune détection » = 1 − P_D au lieu de 1 − P_D P_G",
-                "La cible peut ne pas être détectée (1 − P_D), mais aussi être détectée hors de la porte "
+                "La cible peut ne pas être détectée (1 − P_D), mais aussi être détectée hors de la fenêtre "
                 "(P_D (1 − P_G)) : au total 1 − P_D P_G.",
                 _pw_missed_one_minus_pd, culprit=_WEIGHT_LINE),
     ),
@@ -194,13 +194,13 @@ def _update_cases() -> list[Case]:
     C = np.hstack([np.eye(2), np.zeros((2, 2))])
     R = np.diag([900.0, 400.0])
     z = C @ x + np.array([[20.0, -10.0], [-35.0, 30.0]])
-    cases.append(_update_case("n = 4, m = 2 (radar), deux détections dans la porte", x, P, z, C, R,
+    cases.append(_update_case("n = 4, m = 2 (radar), deux détections dans la fenêtre", x, P, z, C, R,
                               _beta_for(x, P, z, C, R, 0.9, 1e-5, 0.99)))
     # n = 2, m = 1, trois détections, une hors de la porte
     x2, P2 = np.array([0.0, 1.0]), np.array([[2.0, 0.5], [0.5, 1.0]])
     C2, R2 = np.array([[1.0, 0.0]]), np.array([[1.0]])
     z2 = np.array([[0.8], [-1.5], [9.0]])
-    cases.append(_update_case("n = 2, m = 1, trois détections dont une hors de la porte", x2, P2, z2, C2, R2,
+    cases.append(_update_case("n = 2, m = 1, trois détections dont une hors de la fenêtre", x2, P2, z2, C2, R2,
                               _beta_for(x2, P2, z2, C2, R2, 0.8, 0.2, 0.99)))
     # relevé vide : β = [1], la prédiction
     cases.append(_update_case("N = 0 : relevé vide (β = [1]), la correction rend la prédiction", x, P,
@@ -277,7 +277,7 @@ PDA_UPDATE = Exercise(
         Mistake("no-spread", "terme de dispersion oublié",
                 "La covariance PDA est celle d'un mélange : β₀ P⁻ + (1 − β₀)(P⁻ − K S Kᵀ) + K (Σ β_j ν_j ν_jᵀ − "
                 "ν̄ ν̄ᵀ) Kᵀ. Le dernier terme, la dispersion des innovations, dit que la PDA ne sait pas quelle "
-                "détection est la bonne ; sans lui, la piste est trop sûre d'elle et sa porte trop petite.",
+                "détection est la bonne ; sans lui, la piste est trop sûre d'elle et sa fenêtre trop petite.",
                 _pu_no_spread, outputs=(1,), output=1, culprit=_SPREAD_LINE),
         Mistake("spread-no-mean", "dispersion sans retirer ν̄ ν̄ᵀ",
                 "La dispersion est une covariance : Σ β_j ν_j ν_jᵀ − ν̄ ν̄ᵀ, avec ν̄ = Σ β_j ν_j. Sans le second "

@@ -136,6 +136,13 @@ def _ekf_innovation_sign(x_pred, P_pred, y, h, H, R):
     return x, (np.eye(len(x_pred)) - K @ Hx) @ P_pred
 
 
+def _ekf_h_at_corrected(x_pred, P_pred, y, h, H, R):
+    Hx = H(x_pred)
+    K = P_pred @ Hx.T @ np.linalg.inv(Hx @ P_pred @ Hx.T + R)
+    x = x_pred + K @ (y - h(x_pred))
+    return x, (np.eye(len(x_pred)) - K @ H(x)) @ P_pred
+
+
 def _ekf_p_not_updated(x_pred, P_pred, y, h, H, R):
     Hx = H(x_pred)
     K = P_pred @ Hx.T @ np.linalg.inv(Hx @ P_pred @ Hx.T + R)
@@ -170,7 +177,7 @@ EKF_UPDATE = Exercise(
         Mistake("gain-r", "gain P Hᵀ R⁻¹ au lieu de P⁻ Hᵀ S⁻¹",
                 "Comme pour le filtre linéaire, le gain divise par la covariance de l'innovation "
                 "S = H P⁻ Hᵀ + R, pas par R seule.",
-                _ekf_gain_r, culprit=(r"^\s*K\w*\s*=",)),
+                _ekf_gain_r, culprit=(r"^\s*K\w*\s*=",), confirm=(r"\bR",), refute=(r"\bS\b",)),
         Mistake("function-as-array", "H utilisée comme une matrice sans l'évaluer",
                 "`H` est une fonction : la jacobienne au point de linéarisation est la matrice `H(x_pred)`, de forme "
                 "(m, n). Calculez-la une fois (`Hx = H(x_pred)`) puis utilisez `Hx` dans S, K et P.",
@@ -182,6 +189,11 @@ EKF_UPDATE = Exercise(
         Mistake("p-not-updated", "la covariance n'est pas corrigée",
                 "P = (I − K H) P⁻ : la mesure réduit l'incertitude. Votre fonction renvoie P⁻ telle quelle.",
                 _ekf_p_not_updated, outputs=(1,), output=1),
+        Mistake("h-at-corrected", "jacobienne évaluée au point corrigé dans P",
+                "La jacobienne se calcule une fois, au point de linéarisation x⁻ (`H(x_pred)`), et sert dans S, K "
+                "et P = (I − K H) P⁻. Réévaluée au point corrigé x, elle ne correspond plus au gain : P n'est plus "
+                "la covariance du filtre (ni même symétrique).",
+                _ekf_h_at_corrected, outputs=(1,), output=1, culprit=(r"\bH\(\s*x\s*\)",)),
     ),
 )
 
@@ -308,12 +320,20 @@ def _so3_cases() -> list[Case]:
     rng = generator(707)
     axis = rng.standard_normal(3)
     axis /= np.linalg.norm(axis)
+    other = rng.standard_normal(3)
+    other /= np.linalg.norm(other)
+    # chaque régime d'une implémentation à deux branches (petit angle, formule de Rodrigues) : nul, presque nul,
+    # petit (10⁻⁵ : le développement I + [ω]× y est juste, I seule ne l'est plus), moyen, grand, au-delà de π
     return [
-        _so3_case("ω = (0,3 ; −0,2 ; 0,1) rad", np.array([0.3, -0.2, 0.1])),
-        _so3_case("θ = 2,5 rad autour d'un axe quelconque", 2.5 * axis),
+        _so3_case("ω = (0,3 ; −0,2 ; 0,1) rad, angle moyen (θ ≈ 0,37 rad)", np.array([0.3, -0.2, 0.1])),
+        _so3_case("θ = 2,5 rad autour d'un axe quelconque (grand angle)", 2.5 * axis),
         _so3_case("ω = 0 (cas limite : aucune rotation)", np.zeros(3)),
         _so3_case("θ = 10⁻⁹ rad (presque nul)", 1e-9 * axis),
+        _so3_case("θ = 10⁻⁵ rad (petit angle)", 1e-5 * other),
+        _so3_case("θ = 0,05 rad (petit angle, au-delà d'un seuil de quelques 10⁻²)", 0.05 * other),
+        _so3_case("θ = 1 rad autour d'un axe de coordonnées", np.array([0.0, 0.0, 1.0])),
         _so3_case("θ = π (demi-tour)", np.pi * np.array([0.0, 0.6, 0.8])),
+        _so3_case("θ = 4 rad (au-delà de π)", 4.0 * other),
     ]
 
 

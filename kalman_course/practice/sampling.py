@@ -207,20 +207,21 @@ SIGMA_POINTS = Exercise(
                 "Les écarts sont les colonnes d'une racine de (n + λ) P, pas de P : sans le facteur, les points "
                 "sont trop serrés et restituent P/(n + λ) au lieu de P.",
                 _sigma_no_scale, detect=_detect_no_scale,
-                culprit=(r"cholesky|sqrtm",)),
+                culprit=(r"cholesky|sqrtm",), refute=(r"lam|\bn\s*\+|\+\s*n\b|kappa|alpha",)),
         Mistake("elementwise-sqrt", "racine carrée élément par élément (`np.sqrt`) au lieu d'une racine matricielle",
                 "`np.sqrt(P)` prend la racine de chaque coefficient : ce n'est pas une matrice S telle que "
                 "S Sᵀ = (n + λ) P dès que P n'est pas diagonale. Utilisez `np.linalg.cholesky` (ou `scipy.linalg.sqrtm`).",
-                _sigma_elementwise_sqrt, detect=_detect_elementwise, culprit=(r"np\.sqrt\(",)),
+                _sigma_elementwise_sqrt, detect=_detect_elementwise, culprit=(r"np\.sqrt\(",), confirm=(r"\bP\b",)),
         Mistake("cholesky-rows", "lignes de L au lieu de ses colonnes",
                 "Avec L = cholesky((n + λ) P), triangulaire inférieure et L Lᵀ = (n + λ) P, les écarts sont les "
                 "colonnes de L (`L[:, i]`, ou les lignes de `L.T`), pas ses lignes `L[i]`. (Les lignes de la "
                 "triangulaire supérieure U = Lᵀ conviennent : c'est le choix de filterpy.)",
-                _sigma_cholesky_rows, detect=_detect_cholesky_rows, culprit=(r"x\w*\s*[+-]\s*L\b(?!\.T)", r"cholesky")),
+                _sigma_cholesky_rows, detect=_detect_cholesky_rows, culprit=(r"x\w*\s*[+-]\s*L\b(?!\.T)",)),
         Mistake("lambda-without-n", "λ = α²(n + κ) sans le « − n »",
                 "λ = α²(n + κ) − n : avec α = 1 et κ = 0, λ = 0 et les points sont à ±√n écarts-types. "
                 "Sans le « − n », tous les poids sont faux.",
-                _sigma_lambda_without_n, detect=_detect_lambda_without_n, culprit=(r"\blam\w*\s*=", r"\bl\s*=")),
+                _sigma_lambda_without_n, detect=_detect_lambda_without_n, culprit=(r"\blam\w*\s*=", r"\bl\s*="),
+                refute=(r"-\s*n\b",)),
     ),
 )
 
@@ -362,6 +363,8 @@ def _resample_cases() -> list[Case]:
         _resample_case("N = 6 dont deux poids nuls, u = 0,31", w6, 0.31),
         _resample_case("N = 1", np.array([1.0]), 0.42),
         _resample_case("N = 1000, une particule porte 80 % du poids, u = 0,95", w1000 / w1000.sum(), 0.95),
+        _resample_case("N = 27 poids égaux, u = 1 − 10⁻¹⁴ : la somme cumulée des poids s'arrête à 1 − 8 × 10⁻¹⁶, "
+                       "sous la dernière position (arrondi)", np.full(27, 1 / 27), 0.99999999999999),
     ]
 
 
@@ -392,6 +395,18 @@ def _sys_one_based(weights, u):
     N = len(weights)
     positions = (u + np.arange(1, N + 1)) / N
     return np.searchsorted(np.cumsum(weights), positions, side="right")
+
+
+def _sys_last_cumsum(weights, u):
+    N = len(weights)
+    positions = (u + np.arange(N)) / N
+    return np.searchsorted(np.cumsum(weights), positions, side="right")
+
+
+def _detect_last_cumsum(outs, case):
+    w, u = case.args
+    raw = _sys_last_cumsum(w, u)
+    return bool((raw >= w.size).any()) and close(outs[0], raw)
 
 
 def _detect_u_plus_i(outs, case):
@@ -432,11 +447,17 @@ SYSTEMATIC_RESAMPLE = Exercise(
                 "Une position p égale à une somme cumulée cⱼ appartient à la particule suivante : on cherche j "
                 "tel que cⱼ₋₁ ≤ p < cⱼ, soit `np.searchsorted(c, p, side=\"right\")` (ou, dans une boucle, "
                 "`while c[j] <= p: j += 1`).",
-                _sys_left, culprit=(r"searchsorted", r"while.*(>=|<)")),
+                _sys_left, culprit=(r"searchsorted", r"while.*(>=|<)"), refute=(r"side\s*=\s*[\"']right",)),
         Mistake("one-based", "positions (u + i)/N avec i = 1…N au lieu de 0…N − 1",
                 "Les positions commencent à u/N (i = 0) : avec i = 1…N, la dernière dépasse 1 et il n'y a plus "
                 "de particule où la placer.",
                 _sys_one_based, detect=_detect_one_based, culprit=(r"arange\(\s*1", r"range\(\s*1")),
+        Mistake("last-cumsum", "dernière somme cumulée laissée sous 1 (arrondi)",
+                "En flottants, la somme cumulée des poids peut s'arrêter un peu sous 1 (1 − 8 × 10⁻¹⁶ pour 27 "
+                "poids égaux) : une position (u + N − 1)/N juste au-dessus ne tombe alors dans aucune bande et "
+                "reçoit l'indice N, hors des particules. Forcez la dernière somme cumulée à 1 (`c[-1] = 1.0`) "
+                "avant de chercher les bandes.",
+                _sys_last_cumsum, detect=_detect_last_cumsum, culprit=(r"cumsum\(",), refute=(r"\[\s*-1\s*\]",)),
     ),
 )
 
@@ -548,7 +569,7 @@ PARTICLE_WEIGHTS = Exercise(
                 "Les vraisemblances sont minuscules quand la mesure est loin des particules : exp(−1800) vaut 0 en "
                 "flottant, la somme aussi, et 0/0 donne NaN. Travaillez en logarithme et retranchez le plus grand "
                 "log-poids avant l'exponentielle (log-sum-exp) : les poids normalisés ne changent pas.",
-                _pw_no_max, culprit=(r"np\.exp\(",)),
+                _pw_no_max, culprit=(r"np\.exp\(",), refute=(r"max|logsumexp",)),
         Mistake("prior-ignored", "poids précédents oubliés",
                 "Le nouveau poids est l'ancien multiplié par la vraisemblance : log w̃ⁱ = log wⁱ + log N(y ; ŷⁱ, R). "
                 "Sans l'ancien poids, on perd ce que disaient les mesures précédentes (sans rééchantillonnage).",

@@ -63,6 +63,12 @@ def _rts_smoothed_gain(x_filt, P_filt, x_smooth_next, P_smooth_next, A, Q):
     return x_filt + G @ (x_smooth_next - A @ x_filt), P_filt + G @ (P_smooth_next - P_pred) @ G.T
 
 
+def _rts_gain_transposed(x_filt, P_filt, x_smooth_next, P_smooth_next, A, Q):
+    P_pred = A @ P_filt @ A.T + Q
+    G = np.linalg.solve(P_pred, A @ P_filt)
+    return x_filt + G @ (x_smooth_next - A @ x_filt), P_filt + G @ (P_smooth_next - P_pred) @ G.T
+
+
 def _rts_q_forgotten(x_filt, P_filt, x_smooth_next, P_smooth_next, A, Q):
     P_pred = A @ P_filt @ A.T
     G = P_filt @ A.T @ np.linalg.inv(P_pred)
@@ -104,11 +110,16 @@ RTS_STEP = Exercise(
                 "Le gain du lisseur est G = P_{k|k} Aᵀ (P_{k+1|k})⁻¹, avec la covariance **prédite** "
                 "P_{k+1|k} = A P_{k|k} Aᵀ + Q : c'est elle qui relie x_{k+1} à x_k dans la loi jointe. La "
                 "covariance lissée P_{k+1|T} n'intervient que dans la correction.",
-                _rts_smoothed_gain, culprit=_RTS_GAIN),
+                _rts_smoothed_gain, culprit=_RTS_GAIN, confirm=(r"smooth|next",)),
+        Mistake("gain-transposed", "Gᵀ au lieu de G (`.T` oublié après `solve`)",
+                "G = P_{k|k} Aᵀ (P_{k+1|k})⁻¹ est la transposée de la solution X de P_{k+1|k} X = A P_{k|k} : "
+                "`np.linalg.solve(P_pred, A @ P_filt)` donne Gᵀ, il faut ajouter `.T`. (En dimension 1, G = Gᵀ : "
+                "l'oubli ne se voit qu'à partir de n = 2.)",
+                _rts_gain_transposed, culprit=(r"solve\(",), refute=(r"\)\s*\.T\b",)),
         Mistake("q-forgotten", "Q oubliée dans la covariance prédite",
                 "P_{k+1|k} = A P_{k|k} Aᵀ + Q : sans Q, le gain et la correction du lisseur sont faux (et "
                 "A P Aᵀ peut même être singulière).",
-                _rts_q_forgotten, culprit=(r"^\s*P\w*pred\w*\s*=", r"^\s*P\w*\s*=\s*A")),
+                _rts_q_forgotten, culprit=(r"^\s*P\w*pred\w*\s*=", r"^\s*P\w*\s*=\s*A"), refute=(r"\bQ\b",)),
         Mistake("not-predicted", "x_{k|k} au lieu de A x_{k|k} dans la correction",
                 "La correction compare la moyenne lissée suivante à sa **prédiction** : "
                 "x_s = x_{k|k} + G (x_{k+1|T} − A x_{k|k}). Sans A, c'est juste seulement si A = I.",

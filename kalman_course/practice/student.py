@@ -16,6 +16,7 @@ import linecache
 import os
 import re
 import signal
+import sys
 import sysconfig
 import textwrap
 import threading
@@ -72,6 +73,8 @@ class Outcome:
     place: Place | None = None
     timed_out: bool = False
     warnings: list[str] = field(default_factory=list)
+    executed: frozenset[int] | None = None
+    returned: int | None = None
 
     @property
     def ok(self) -> bool:
@@ -82,21 +85,36 @@ class _TimeUp(BaseException):
     """Levée par l'alarme quand la fonction de l'étudiant dépasse :data:`TIME_LIMIT`."""
 
 
+#: Après le temps accordé, l'alarme sonne de nouveau à cet intervalle (s) tant que la fonction n'a pas rendu
+#: la main : un ``except:`` (ou ``except BaseException``) de l'étudiant qui avale la première interruption
+#: ne bloque pas le noyau, la suivante tombe hors de son ``try``.
+_REPEAT = 0.02
+
+
+class _Clock:
+    """L'alarme d'un appel : ``expired`` dit si le temps accordé est écoulé (même si l'interruption a été
+    avalée par le code de l'étudiant)."""
+
+    expired = False
+
+
 @contextlib.contextmanager
 def _time_limit(seconds: float):
-    """Alarme (SIGALRM) sur le fil principal d'Unix ; ailleurs, pas de limite."""
+    """Alarme (SIGALRM) sur le fil principal d'Unix, répétée après l'échéance ; ailleurs, pas de limite."""
+    clock = _Clock()
     usable = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
     if not usable or seconds <= 0:
-        yield
+        yield clock
         return
 
     def _raise(signum, frame):  # noqa: ARG001
+        clock.expired = True
         raise _TimeUp
 
     previous = signal.signal(signal.SIGALRM, _raise)
-    old_delay, _ = signal.setitimer(signal.ITIMER_REAL, seconds)
+    old_delay, _ = signal.setitimer(signal.ITIMER_REAL, seconds, _REPEAT)
     try:
-        yield
+        yield clock
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
@@ -115,8 +133,9 @@ def _is_student_file(filename: str) -> bool:
     return not any(real.startswith(d + os.sep) for d in _LIBRARY_DIRS)
 
 
-def _student_place(exc: BaseException, fn: Callable) -> Place | None:
-    """La ligne la plus profonde du code de l'étudiant dans la trace de ``exc``."""
+def _student_place(exc: BaseException, fn: Callable, fallback: bool = True) -> Place | None:
+    """La ligne la plus profonde du code de l'étudiant dans la trace de ``exc`` (sinon, si ``fallback``, la
+    première ligne de ``fn``)."""
     tb = exc.__traceback__
     place = None
     while tb is not None:
@@ -125,28 +144,79 @@ def _student_place(exc: BaseException, fn: Callable) -> Place | None:
             line = linecache.getline(code.co_filename, tb.tb_lineno, tb.tb_frame.f_globals)
             place = Place(code.co_filename, tb.tb_lineno, line)
         tb = tb.tb_next
-    if place is None:
+    if place is None and fallback:
         source = source_of(fn)
         if source is not None:
             place = source.place(source.first)
     return place
 
 
-def call(fn: Callable, args: tuple, time_limit: float | None = None) -> Outcome:
+class _Lines:
+    """Les lignes exécutées par la fonction de l'étudiant (son dernier appel terminé) et celle qui a rendu la
+    main : le correcteur ne nomme que des lignes qui ont vraiment tourné (une branche ``if`` non prise n'est
+    jamais accusée)."""
+
+    def __init__(self, fn: Callable) -> None:
+        try:
+            self.target = inspect.unwrap(fn).__code__
+        except AttributeError:
+            self.target = None
+        self.executed: frozenset[int] | None = None
+        self.returned: int | None = None
+
+    def __enter__(self) -> "_Lines":
+        self.previous = sys.gettrace()
+        if self.target is not None:
+            sys.settrace(self._global)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.target is not None:
+            sys.settrace(self.previous)
+
+    def _global(self, frame, event, arg):  # noqa: ARG002
+        if event != "call" or frame.f_code is not self.target:
+            return None
+        lines: set[int] = set()
+
+        def local(frame, event, arg):  # noqa: ARG001
+            if event == "line":
+                lines.add(frame.f_lineno)
+            elif event == "return":
+                self.executed, self.returned = frozenset(lines), frame.f_lineno
+            return local
+
+        return local
+
+
+def call(fn: Callable, args: tuple, time_limit: float | None = None, fallback: bool = True) -> Outcome:
     """Appelle ``fn(*args)`` : jamais d'exception (sauf l'interruption demandée par l'utilisateur), les
-    avertissements de numpy sont relevés et tus (les NaN et infinis sont jugés sur le résultat)."""
+    avertissements de numpy sont relevés et tus (les NaN et infinis sont jugés sur le résultat).
+    ``fallback`` : si l'exception ne passe par aucune ligne de l'étudiant, nommer la première ligne de ``fn``
+    (vrai quand ``fn`` est la fonction de l'étudiant ; faux quand c'est une expérience du paquet qui
+    l'appelle)."""
     with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
         warnings.simplefilter("always")
+        lines = _Lines(fn) if fallback else None
         try:
-            with _time_limit(TIME_LIMIT if time_limit is None else time_limit):
-                value = fn(*args)
+            with _time_limit(TIME_LIMIT if time_limit is None else time_limit) as clock:
+                if lines is None:
+                    value = fn(*args)
+                else:
+                    with lines:
+                        value = fn(*args)
         except _TimeUp:
             return Outcome(timed_out=True)
         except KeyboardInterrupt:
             raise
         except BaseException as exc:  # noqa: BLE001 — le code de l'étudiant peut lever n'importe quoi
-            return Outcome(error=exc, place=_student_place(exc, fn))
-    return Outcome(value=value, warnings=[str(w.message) for w in caught])
+            if clock.expired:  # l'interruption avalée, puis une autre exception : le temps était écoulé
+                return Outcome(timed_out=True)
+            return Outcome(error=exc, place=_student_place(exc, fn, fallback))
+    if clock.expired:  # la fonction a avalé l'interruption puis rendu un résultat : hors délai
+        return Outcome(timed_out=True)
+    return Outcome(value=value, warnings=[str(w.message) for w in caught],
+                   executed=None if lines is None else lines.executed, returned=None if lines is None else lines.returned)
 
 
 # --------------------------------------------------------------------------- lecture du code
@@ -229,6 +299,25 @@ class StudentSource:
     lines: list[str]
     assigned: dict[str, list[int]]
     returns: list[ast.Return]
+    #: lignes exécutées (numérotation du fichier) et ligne qui a rendu la main, au dernier appel jugé
+    executed: frozenset[int] | None = None
+    returned: int | None = None
+
+    def follow(self, outcome: "Outcome") -> None:
+        """Retient les lignes exécutées par l'appel ``outcome`` : les lignes nommées ensuite en font partie."""
+        self.executed, self.returned = outcome.executed, outcome.returned
+
+    def _ran(self, lineno: int) -> bool:
+        return self.executed is None or lineno in self.executed
+
+    def _return_node(self) -> ast.Return | None:
+        """Le ``return`` qui a rendu la main (s'il est connu), sinon le seul ``return`` ; ``None`` si on ne
+        peut pas le savoir (plusieurs ``return``)."""
+        if self.returned is not None:
+            for node in self.returns:
+                if self._file_line(node.lineno) == self.returned:
+                    return node
+        return self.returns[0] if len(self.returns) == 1 else None
 
     def place(self, lineno: int) -> Place:
         """La ligne ``lineno`` (numérotation de la cellule ou du fichier)."""
@@ -247,34 +336,38 @@ class StudentSource:
         return self.place(self.first)
 
     def return_place(self) -> Place | None:
-        """La (dernière) ligne ``return`` de la fonction."""
-        if not self.returns:
+        """La ligne ``return`` qui a rendu la main (ou la seule de la fonction)."""
+        ret = self._return_node()
+        if ret is None:
             return None
-        return self.place(self._file_line(self.returns[-1].lineno))
+        return self.place(self._file_line(ret.lineno))
 
     def output_place(self, index: int, n_outputs: int) -> Place | None:
-        """La ligne qui calcule la sortie ``index`` : la dernière affectation du nom renvoyé à cette
-        position (``return x_pred, P_pred`` → la ligne ``P_pred = …``), sinon la ligne ``return``."""
-        if not self.returns:
+        """La ligne qui calcule la sortie ``index`` : la dernière affectation exécutée du nom renvoyé à cette
+        position (``return x_pred, P_pred`` → la ligne ``P_pred = …``), sinon la ligne ``return`` ; ``None``
+        si on ne sait pas quel ``return`` a servi."""
+        ret = self._return_node()
+        if ret is None:
             return None
-        ret = self.returns[-1]
         value = ret.value
         if n_outputs > 1 and isinstance(value, (ast.Tuple, ast.List)) and len(value.elts) == n_outputs:
             value = value.elts[index]
         elif n_outputs > 1:
             return self.place(self._file_line(ret.lineno))
         if isinstance(value, ast.Name):
-            before = [ln for ln in self.assigned.get(value.id, []) if ln <= ret.lineno]
+            before = [ln for ln in self.assigned.get(value.id, []) if ln <= ret.lineno
+                      and self._ran(self._file_line(ln))]
             if before:
                 return self.place(self._file_line(max(before)))
         return self.place(self._file_line(getattr(value, "lineno", ret.lineno)))
 
     def find(self, patterns: tuple[str, ...]) -> Place | None:
-        """La dernière ligne (hors commentaires) qui correspond à l'un des motifs, essayés dans l'ordre."""
+        """La dernière ligne exécutée (hors commentaires) qui correspond à l'un des motifs, essayés dans
+        l'ordre."""
         for pattern in patterns:
             regex = re.compile(pattern)
             for i in range(len(self.lines) - 1, -1, -1):
-                if regex.search(_code_only(self.lines[i])):
+                if self._ran(self.first + i) and regex.search(_code_only(self.lines[i])):
                     return self.place(self.first + i)
         return None
 

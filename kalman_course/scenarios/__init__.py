@@ -19,6 +19,7 @@ from . import labs  # noqa: F401  (travaux pratiques : le filtre de l'étudiant 
 from . import tutorials  # noqa: F401  (travaux dirigés : les exemples calculés à la main)
 from . import helicopter, manoeuvre  # noqa: F401  (pistage : l'hélicoptère SAMU 31, la cible qui manœuvre)
 from . import grid_bayes  # noqa: F401  (filtre bayésien exact sur une grille : le modèle de croissance)
+from . import robot_localization  # noqa: F401  (robot plan, odométrie et GNSS : EKF invariant sur SE(2))
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
@@ -30,6 +31,7 @@ __all__ = [
     "helicopter",
     "manoeuvre",
     "grid_bayes",
+    "robot_localization",
     "importance",
     "labs",
     "tutorials",

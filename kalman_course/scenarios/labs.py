@@ -11,7 +11,9 @@ Le code de l'étudiant n'interrompt jamais l'expérience : s'il échoue, ``stude
 * :func:`pendulum_lab` — TP 3 : un UKF (points sigma et transformée de l'étudiant) et un filtre
   particulaire (poids et rééchantillonnage de l'étudiant) sur le pendule ;
 * :func:`nile_lab` — TP 4 : le lisseur RTS et l'étape M de l'étudiant sur le Nil ;
-* :func:`pda_lab` — TP 5 : les poids et la correction PDA de l'étudiant, sur l'hélicoptère de la scène de
+* :func:`samu_lab` — TP 5 : le modèle à vitesse presque constante, la porte, la discrétisation de Van Loan et
+  l'IMM de l'étudiant sur le vol réel de l'hélicoptère SAMU 31.
+* :func:`pda_lab` — TP 6 : les poids et la correction PDA de l'étudiant, sur l'hélicoptère de la scène de
   Blagnac dans un fouillis dense.
 """
 
@@ -39,8 +41,9 @@ from .tag import TAG_RANGE_STD, tag_data, tag_model, tag_ranges
 from .voltage import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
 
 __all__ = [
-    "LabRun", "voltage_lab", "tag_lab", "pendulum_lab", "nile_lab", "pda_lab",
+    "LabRun", "voltage_lab", "tag_lab", "pendulum_lab", "nile_lab", "samu_lab", "pda_lab",
     "LAB_UKF", "LAB_PARTICLES", "LAB_PF_SEED", "LAB_NILE_PRIOR", "LAB_EM_START", "LAB_EM_ITERATIONS",
+    "LAB_SAMU_Q", "LAB_SAMU_POSITION_STD", "LAB_SAMU_GATE", "LAB_SAMU_MODES", "LAB_SAMU_SWITCH",
     "LAB_PDA_CLUTTER",
 ]
 
@@ -54,7 +57,16 @@ LAB_NILE_PRIOR = (np.array([1000.0]), np.array([[1e6]]))
 #: Départ d'EM du TP 4 : :math:`(\sigma^2_\varepsilon, \sigma^2_\eta)`, et nombre d'itérations.
 LAB_EM_START = (1e4, 1e3)
 LAB_EM_ITERATIONS = 30
-#: Densité du fouillis du TP 5 (par m² et par relevé : 44 fausses détections par relevé sur la zone).
+#: TP 5 : densité (m²/s³) et écart-type des positions (m) du filtre unique, arrondis des valeurs apprises par
+#: maximum de vraisemblance au chapitre « Plusieurs capteurs, temps irrégulier » (12,5 m²/s³ et 1,86 m).
+LAB_SAMU_Q = 12.5
+LAB_SAMU_POSITION_STD = 1.9
+#: Probabilité de la porte du TP 5.
+LAB_SAMU_GATE = 0.999
+#: Densités (m²/s³) des régimes calme et agité de l'IMM du TP 5, et probabilité de quitter son régime.
+LAB_SAMU_MODES = (3.0, 100.0)
+LAB_SAMU_SWITCH = 0.02
+#: Densité du fouillis du TP 6 (par m² et par relevé : 44 fausses détections par relevé sur la zone).
 LAB_PDA_CLUTTER = 1e-7
 
 
@@ -72,7 +84,8 @@ class LabRun:
 
 
 def _solution(exercise_id: str, fn: Callable | None) -> Callable:
-    return practice.exercise(exercise_id).solution if fn is None else fn
+    """La fonction de l'étudiant (son résultat vérifié à chaque appel), ou la solution de référence."""
+    return practice.exercise(exercise_id).solution if fn is None else practice.validated(exercise_id, fn)
 
 
 def _run(run: Callable[[], dict]) -> tuple[dict | None, str | None]:
@@ -262,7 +275,101 @@ def nile_lab(rts_step: Callable | None = None, m_step: Callable | None = None) -
     return LabRun({"year": np.asarray(series.year), "y": y}, reference, student, message)
 
 
-# --------------------------------------------------------------------------- TP 5 : la PDA
+
+# --------------------------------------------------------------------------- TP 5 : l'hélicoptère du SAMU 31
+
+
+def samu_lab(cv_model: Callable | None = None, nis_gate: Callable | None = None, van_loan: Callable | None = None,
+             imm_mix: Callable | None = None, mode_probabilities: Callable | None = None,
+             imm_merge: Callable | None = None) -> LabRun:
+    r"""Le vol réel de l'hélicoptère SAMU 31 (positions seules, instants irréguliers), deux expériences :
+
+    * **la porte** — un filtre de Kalman dont le modèle de chaque pas vient du ``cv_model`` de l'étudiant
+      (:data:`LAB_SAMU_Q`, :data:`LAB_SAMU_POSITION_STD`) et dont chaque position passe par sa ``nis_gate``
+      (:data:`LAB_SAMU_GATE`), sur les positions corrompues du chapitre
+      (:func:`~kalman_course.scenarios.helicopter.with_outliers`), contre
+      :func:`~kalman_course.kalman_filter` ``(…, gate=…)`` ;
+    * **l'IMM** calme/agité (:data:`LAB_SAMU_MODES`, :data:`LAB_SAMU_SWITCH`) sur le vol propre : modèle de
+      chaque pas par le ``van_loan`` de l'étudiant, mélange, probabilités et combinaison par ses fonctions ;
+      prédiction et correction de chaque régime par le paquet (:func:`~kalman_course.predict`,
+      :func:`~kalman_course.update`) ; contre :func:`~kalman_course.imm_filter`.
+
+    ``reference`` et ``student`` : ``gate_x`` (K, 4), ``rejected`` (K,) booléens, ``imm_x`` (K, 4), ``mu`` (K, 2)
+    (``None`` pour la partie qui a échoué)."""
+    from ..core.motion import constant_velocity_sde
+    from ..filters.imm import imm_filter
+    from ..filters.kalman import kalman_family
+    from .helicopter import OUTLIER_ROWS, helicopter_model, helicopter_track, with_outliers
+
+    cv, gate = _solution("cv-model", cv_model), _solution("nis-gate", nis_gate)
+    vl, mix = _solution("van-loan", van_loan), _solution("imm-mix", imm_mix)
+    probabilities, merge = _solution("mode-probabilities", mode_probabilities), _solution("imm-merge", imm_merge)
+    track = helicopter_track("position")
+    y, y_bad, dt = np.asarray(track.y), with_outliers(track), np.asarray(track.dt)
+    x0, P0, C = np.asarray(track.x0), np.asarray(track.P0), np.asarray(track.C)
+    R = LAB_SAMU_POSITION_STD**2 * np.eye(2)
+    gated = kalman_filter(helicopter_model(track, LAB_SAMU_Q, LAB_SAMU_POSITION_STD), y_bad, x0, P0,
+                          gate=LAB_SAMU_GATE)
+    transition = np.array([[1.0 - LAB_SAMU_SWITCH, LAB_SAMU_SWITCH], [LAB_SAMU_SWITCH, 1.0 - LAB_SAMU_SWITCH]])
+    mu0 = np.array([1.0 - LAB_SAMU_SWITCH, LAB_SAMU_SWITCH])
+    modes = [helicopter_model(track, q, LAB_SAMU_POSITION_STD) for q in LAB_SAMU_MODES]
+    imm = imm_filter(modes, y, x0, P0, transition=transition, mu0=mu0)
+    reference = {"gate_x": gated.x, "rejected": np.asarray(gated.rejected, dtype=bool), "imm_x": imm.x, "mu": imm.mu}
+
+    kf = kalman_family("textbook")  # les étapes pures du filtre de Kalman du paquet (celles de son moteur)
+    K = len(y)
+
+    def gate_run():
+        steps = [cv(float(dt[k]), LAB_SAMU_Q) for k in range(K)]
+        model = LinearGaussianModel(np.array([a for a, _ in steps]), C, np.array([q for _, q in steps]), R)
+        x, P = x0.copy(), P0.copy()
+        xs, rejected = [], []
+        for k, step in enumerate(model.steps(K)):
+            x_pred, P_pred = kf.predict(step, (x, P), None)
+            nu = y_bad[k] - C @ x_pred
+            S = C @ P_pred @ C.T + R
+            accept = bool(np.asarray(gate(nu, S, LAB_SAMU_GATE)[2]))
+            (x, P), _ = kf.update(step, (x_pred, P_pred), y_bad[k], None) if accept else ((x_pred, P_pred), None)
+            xs.append(x)
+            rejected.append(not accept)
+        return {"gate_x": np.array(xs), "rejected": np.array(rejected)}
+
+    def imm_run():
+        F, L = constant_velocity_sde(2)
+        unit = [vl(F, L, np.eye(2), float(dt[k])) for k in range(K)]  # densité 1 : Q est proportionnelle à q
+        A, Q1 = np.array([a for a, _ in unit]), np.array([q for _, q in unit])
+        per_mode = [LinearGaussianModel(A, C, q * Q1, R).steps(K) for q in LAB_SAMU_MODES]
+        X, P = np.tile(x0, (2, 1)), np.tile(P0, (2, 1, 1))
+        mu = mu0.copy()
+        xs, mus = [], []
+        for k in range(K):
+            cbar, X0, P0_mixed = mix(X, P, mu, transition)
+            X, P = np.empty_like(X), np.empty_like(P)
+            nus, Ss = [], []
+            for j, steps in enumerate(per_mode):
+                predicted = kf.predict(steps[k], (X0[j], P0_mixed[j]), None)
+                (X[j], P[j]), correction = kf.update(steps[k], predicted, y[k], None)
+                nus.append(correction.innovation)
+                Ss.append(correction.S)
+            mu = probabilities(cbar, np.array(nus), np.array(Ss))
+            x, _ = merge(X, P, mu)
+            xs.append(x)
+            mus.append(mu)
+        return {"imm_x": np.array(xs), "mu": np.array(mus)}
+
+    gate_values, gate_message = _run(gate_run)
+    imm_values, imm_message = _run(imm_run)
+    student = {**(gate_values or {"gate_x": None, "rejected": None}), **(imm_values or {"imm_x": None, "mu": None})}
+    messages = [f"porte : {gate_message}" if gate_message else "", f"IMM : {imm_message}" if imm_message else ""]
+    message = " ; ".join(m for m in messages if m) or None
+    outliers = np.flatnonzero(track.position_rows)[list(OUTLIER_ROWS)]
+    from .manoeuvre import measured_turn_rate
+
+    rate_t, rate = measured_turn_rate(track.flight)
+    return LabRun({"t": np.asarray(track.t), "y": y, "y_bad": y_bad, "outliers": outliers, "rate_t": rate_t,
+                   "rate": rate}, reference, student, message)
+
+# --------------------------------------------------------------------------- TP 6 : la PDA
 
 
 def pda_lab(pda_weights: Callable | None = None, pda_update: Callable | None = None) -> LabRun:

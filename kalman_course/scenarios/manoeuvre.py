@@ -116,7 +116,8 @@ class ManoeuvreStudy:
     moyenne de position de chaque filtre à chaque pas (m) ; ``nees`` (F, T) : NEES moyen (4 états) ;
     ``rmse_straight``, ``rmse_turn`` (F,) : erreur quadratique moyenne de position en ligne droite et en
     virage ; ``nees_mean`` (F,) : NEES moyen sur tout le vol ; ``band`` : intervalle à 95 % du NEES moyen
-    de :data:`N_RUNS` tirages d'un filtre cohérent ; ``example`` : les filtres de la première trajectoire ;
+    de :data:`N_RUNS` tirages d'un filtre cohérent, à un instant (à comparer pas à pas :
+    :meth:`band_shares`) ; ``example`` : les filtres de la première trajectoire ;
     ``truth``, ``y`` : cette trajectoire ; ``names`` : :data:`FILTERS`."""
 
     t: np.ndarray
@@ -137,6 +138,17 @@ class ManoeuvreStudy:
 
     def index(self, name: str) -> int:
         return self.names.index(name)
+
+    def band_shares(self, name: str) -> tuple[float, float, float]:
+        r"""Parts des pas (après les 10 premières secondes) où le NEES moyen du filtre ``name`` sur les
+        :data:`N_RUNS` trajectoires est **sous** l'intervalle à 95 % d'un filtre cohérent (filtre prudent :
+        sa covariance surestime son erreur), **dedans**, et **au-dessus** (filtre trop sûr de lui).
+        C'est pas à pas qu'il faut comparer à :attr:`band` : l'intervalle est celui d'une moyenne sur
+        :data:`N_RUNS` tirages à un instant, pas d'une moyenne sur le temps."""
+        settled = self.t > 10.0
+        e = self.nees[self.index(name), settled]
+        lo, hi = self.band
+        return float(np.mean(e < lo)), float(np.mean((e >= lo) & (e <= hi))), float(np.mean(e > hi))
 
 
 @dataclass(frozen=True, eq=False)

@@ -30,13 +30,10 @@ console) ; le mode sombre et les petits écrans ont leurs règles (``kc/kc-pages
 cachée (``kc``, ``np``…) : avant la première cellule visible, un bloc dépliable « Importations du
 chapitre » donne ces lignes d'importation, à copier d'abord.
 
-**Recherche.** Les extraits des résultats de recherche montrent les formules en texte lisible
-(« P⁻ », pas « \(P^-\) »).
-
-**Démonstrations.** sphinx-proof écrit ``{prf:proof}`` sans titre, avec « Proof. » collé au texte et le
-même identifiant ``proof`` pour toutes (le script qui replie les encadrés ``:class: dropdown`` cherche un
-titre, et deux identifiants égaux sont une faute d'accessibilité) : :func:`french_proof` lui donne le titre
-« Démonstration », retire « Proof. » et un identifiant propre à chaque démonstration.
+**Recherche.** Le champ de recherche parle français (« Rechercher dans le livre… ») ; l'index de
+recherche ne contient pas le TeX des formules (on ne trouve plus une page en cherchant « aligned ») ; les
+extraits des résultats montrent les formules en texte lisible (« P⁻ », pas « \(P^-\) ») et ne lisent que
+l'article de la page (ni sa table des matières, ni les importations : ``kc/kc-pages.js``).
 """
 
 from __future__ import annotations
@@ -46,12 +43,10 @@ import json
 import re
 from pathlib import Path
 
-from docutils import nodes
-from sphinx.transforms import SphinxTransform
 from sphinx.util import logging
 
-__all__ = ["setup", "ASSETS", "css_glyphs", "icon_css", "fontawesome_icons", "hidden_imports", "subset_fonts", "imports_block", "mermaid_alt",
-           "extract_figure_data", "french_proof", "PROOF_TITLE"]
+__all__ = ["setup", "ASSETS", "SEARCH_TEXT", "css_glyphs", "icon_css", "fontawesome_icons", "hidden_imports",
+           "subset_fonts", "imports_block", "mermaid_alt", "extract_figure_data", "without_math"]
 
 LOGGER = logging.getLogger(__name__)
 
@@ -59,6 +54,8 @@ LOGGER = logging.getLogger(__name__)
 ASSETS = Path(__file__).resolve().parent / "assets"
 #: Dossier des données des figures, sous ``_static/``.
 DATA_DIR = "kc-data"
+#: Le texte du champ de recherche (le thème écrit « Search this book... », sans traduction).
+SEARCH_TEXT = "Rechercher dans le livre…"
 
 _FIGURE_DATA = re.compile(r'<script type="application/json" id="(kc-[a-z0-9-]+)-item">(.*?)</script>', re.S)
 _CITATION_LIST = re.compile(r'<div role="list" class="citation-list">')
@@ -74,6 +71,9 @@ def _configure(app, config) -> None:
     Le menu contextuel de MathJax met chaque formule dans l'ordre de tabulation : s'il est chargé
     (``tex-chtml.js`` le contient), on l'en retire ; le livre charge MathJax en composants, sans menu
     (``_config.yml``), et n'a rien à régler."""
+    options = dict(config.html_theme_options or {})
+    options["search_bar_text"] = SEARCH_TEXT
+    config.html_theme_options = options
     mathjax = dict(config.mathjax3_config or {})
     load = (mathjax.get("loader") or {}).get("load")
     if load is not None and "ui/menu" not in load:
@@ -98,6 +98,32 @@ def _favicon(config) -> None:
 def _static_path(app) -> None:
     if app.builder.format == "html":
         app.config.html_static_path.append(str(ASSETS))
+        _index_without_math(app.builder)
+
+
+def without_math(doctree):
+    """Une copie de ``doctree`` sans ses formules (``math``, ``math_block``) : ce que lit l'index de recherche."""
+    from docutils import nodes
+
+    copy = doctree.deepcopy()
+    for node in list(copy.findall(lambda n: isinstance(n, (nodes.math, nodes.math_block)))):
+        node.parent.remove(node)
+    return copy
+
+
+def _index_without_math(builder) -> None:
+    """L'index de recherche de Sphinx lit le TeX des formules comme des mots (« aligned », « split »,
+    « mathbb ») : le constructeur lui donne une copie de chaque page sans ses formules. (Sphinx 7 n'a pas
+    de réglage pour cela ; ``index_page`` est la seule entrée de l'index, appelée avant l'écriture.)"""
+    index_page = getattr(builder, "index_page", None)
+    if index_page is None or getattr(index_page, "_kc_without_math", False):
+        return
+
+    def index_page_without_math(pagename, doctree, title):
+        return index_page(pagename, without_math(doctree), title)
+
+    index_page_without_math._kc_without_math = True
+    builder.index_page = index_page_without_math
 
 
 # --------------------------------------------------------------------------- page par page
@@ -339,39 +365,7 @@ def _write_icons(app, exception) -> None:
     target.write_text(icon_css(used, icons) + subset_fonts(outdir / "_static", glyphs))
 
 
-#: Le titre des démonstrations (``{prf:proof}``).
-PROOF_TITLE = "Démonstration"
-
-
-def french_proof(node: nodes.admonition, document) -> None:
-    """Une démonstration de sphinx-proof (``nodes.admonition`` de classes ``proof``, identifiant ``proof``) en
-    français : titre :data:`PROOF_TITLE` en tête, « Proof. » retiré du premier paragraphe, identifiant
-    ``demonstration-1``, ``demonstration-2``… unique dans le document."""
-    first = node.next_node(nodes.paragraph)
-    if first is not None and first.children and isinstance(first[0], nodes.Text) \
-            and first[0].astext().startswith("Proof. "):
-        first[0] = nodes.Text(first[0].astext()[len("Proof. "):])
-    if not (node.children and isinstance(node[0], nodes.title)):
-        node.insert(0, nodes.title("", PROOF_TITLE))
-    for old in node["ids"]:
-        document.ids.pop(old, None)
-    node["ids"] = []
-    document.set_id(node, suggested_prefix="demonstration")  # (l'ajoute à node["ids"])
-
-
-class FrenchProofs(SphinxTransform):
-    """Applique :func:`french_proof` à chaque démonstration de sphinx-proof."""
-
-    default_priority = 700
-
-    def apply(self, **kwargs) -> None:
-        for node in list(self.document.findall(nodes.admonition)):
-            if "proof" in node["classes"] and node["ids"] == ["proof"]:
-                french_proof(node, self.document)
-
-
 def setup(app):
-    app.add_transform(FrenchProofs)
     app.connect("config-inited", _configure)
     app.connect("builder-inited", _static_path)
     # avant le dédoublonnage des scripts de sphinx_ext (900), qui remplace la liste du contexte

@@ -11,8 +11,12 @@ chapitre (MyST) :
     Quand la variance de mesure $R$ diminue, le gain $K$…
 
     - diminue ;
+
+      C'est l'effet d'une mesure **moins** précise : $R$ grandit, la mesure pèse moins.
     - augmente ;
     - ne change pas.
+
+      Le gain dépend de $R$ : seule la prédiction ne le voit pas.
 
     $K = P^-/(P^- + R)$ croît quand $R$ décroît : la mesure, plus précise, pèse davantage.
     :::
@@ -20,15 +24,22 @@ chapitre (MyST) :
 
 Dans une question, ce qui précède la **première liste à puces** est l'énoncé, les éléments de la liste
 sont les réponses proposées (``:answer:`` : numéro de la bonne, à partir de 1), ce qui suit est
-l'explication. ``:name:`` donne un identifiant stable à la question (pour les tests).
+l'explication. Une réponse proposée peut porter, après une ligne vide et en retrait, son **message** :
+pour une mauvaise réponse, l'erreur qu'elle trahit (affiché quand on la choisit). ``:name:`` donne un
+identifiant stable à la question (pour les tests).
 
 - **HTML** : chaque question est un groupe de boutons radio, un bouton « Vérifier » et une zone de
   réponse ; quelques lignes de JavaScript sans dépendance, ajoutées une fois aux seules pages qui ont
-  un quiz, comparent le choix à la bonne réponse, l'annoncent (« Juste ! » ou « Pas tout à fait ») et
-  déplient l'explication. Aucun serveur, aucun noyau, aucune requête.
+  un quiz, comparent le choix à la bonne réponse, l'annoncent (« Juste ! » ou « Pas tout à fait »),
+  montrent le message de la réponse choisie et déplient l'explication. Aucun serveur, aucun noyau,
+  aucune requête.
 - **Autres sorties** (LaTeX/PDF, texte) : les questions deviennent une liste numérotée, les réponses
-  proposées des sous-listes (a), (b), (c)… et les bonnes réponses, avec leur explication, sont
-  regroupées sous un intertitre « Réponses du quiz » à la fin du chapitre.
+  proposées des sous-listes (a), (b), (c)… et les bonnes réponses, avec leur explication et le message de
+  chaque mauvaise réponse, sont regroupées sous un intertitre « Réponses du quiz » à la fin du chapitre.
+
+Les règles de rédaction (la bonne réponse n'est pas le plus souvent la plus longue, chaque mauvaise
+réponse a son message) sont vérifiées sur tout le livre par ``tests/test_quiz.py`` (:func:`quiz_questions`
+lit les questions d'une page MyST).
 """
 
 from __future__ import annotations
@@ -40,7 +51,10 @@ from docutils.parsers.rst import directives
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
-__all__ = ["setup", "QUIZ_MARKER", "QUIZ_SCRIPT", "quiz", "quiz_question", "tex_to_text", "choice_text"]
+from ..quizzes import QuizQuestion, plain_text, quiz_questions, tex_to_text  # noqa: F401 (lus par les tests)
+
+__all__ = ["setup", "QUIZ_MARKER", "QUIZ_SCRIPT", "quiz", "quiz_question", "tex_to_text", "choice_text",
+           "QuizQuestion", "quiz_questions", "plain_text"]
 
 LOGGER = logging.getLogger(__name__)
 
@@ -72,6 +86,10 @@ class quiz_choice(nodes.General, nodes.TextElement):
 
 class quiz_explanation(nodes.General, nodes.Element):
     """L'explication, dépliée après la première vérification."""
+
+
+class quiz_why(nodes.General, nodes.Element):
+    """Le message d'une réponse proposée (``index`` : son numéro), montré quand on la choisit."""
 
 
 class QuizDirective(SphinxDirective):
@@ -120,16 +138,22 @@ class QuestionDirective(SphinxDirective):
         statement = quiz_statement()
         statement.extend(body.children[:k])
         choices = quiz_choices()
+        whys = []
         for index, item in enumerate(items, start=1):
             choice = quiz_choice(index=index)
-            content = item.children
-            # un seul paragraphe : son contenu en ligne (un <label> n'admet pas de <p>)
-            if len(content) == 1 and isinstance(content[0], nodes.paragraph):
-                content = content[0].children
+            content, why = item.children, []
+            # le premier paragraphe : la réponse, en ligne (un <label> n'admet pas de <p>) ; la suite : son message
+            if content and isinstance(content[0], nodes.paragraph):
+                content, why = content[0].children, content[1:]
             choice.extend([c.deepcopy() for c in content])
             choices += choice
+            if why:
+                node = quiz_why(index=index)
+                node.extend([c.deepcopy() for c in why])
+                whys.append(node)
         explanation = quiz_explanation()
         explanation.extend(body.children[k + 1:])
+        explanation.extend(whys)
         question += [statement, choices, explanation]
         return [question]
 
@@ -138,46 +162,6 @@ class QuestionDirective(SphinxDirective):
 
 
 # --------------------------------------------------------------------------- texte des réponses (lecteurs d'écran)
-
-_GREEK = {"alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "epsilon": "ε", "varepsilon": "ε", "eta": "η",
-          "theta": "θ", "kappa": "κ", "lambda": "λ", "mu": "μ", "nu": "ν", "xi": "ξ", "pi": "π", "rho": "ρ",
-          "sigma": "σ", "tau": "τ", "phi": "φ", "varphi": "φ", "chi": "χ", "psi": "ψ", "omega": "ω",
-          "Gamma": "Γ", "Delta": "Δ", "Theta": "Θ", "Lambda": "Λ", "Sigma": "Σ", "Phi": "Φ", "Psi": "Ψ",
-          "Omega": "Ω", "ell": "ℓ", "infty": "∞", "approx": "≈", "le": "≤", "leq": "≤", "ge": "≥", "geq": "≥",
-          "neq": "≠", "times": "×", "cdot": "·", "pm": "±", "to": "→", "rightarrow": "→", "in": "∈",
-          "sum": "Σ", "partial": "∂", "nabla": "∇", "top": "ᵀ", "star": "*", "mid": "|", "quad": " ",
-          "qquad": " ", "ldots": "…", "dots": "…", "lvert": "|", "rvert": "|", "lVert": "‖", "rVert": "‖"}
-_SUP = dict(zip("0123456789-+Tnik*", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺ᵀⁿⁱᵏ*"))
-_SUB = dict(zip("0123456789-+nkijmaeoxrtps", "₀₁₂₃₄₅₆₇₈₉₋₊ₙₖᵢⱼₘₐₑₒₓᵣₜₚₛ"))
-
-
-def _script(text: str, table: dict[str, str], mark: str) -> str:
-    text = text.replace(" ", "")
-    if all(c in table for c in text):
-        return "".join(table[c] for c in text)
-    return f"{mark}({text})" if len(text) > 1 else f"{mark}{text}"
-
-
-def tex_to_text(tex: str) -> str:
-    r"""Une formule TeX en texte lisible par un lecteur d'écran : ``\hat x_{n}^-`` → « x̂ₙ⁻ »,
-    ``K = P^-/(P^- + R)`` → « K = P⁻/(P⁻ + R) » (le même texte que les extraits de la recherche du site)."""
-    t = tex
-    t = re.sub(r"\\(?:hat|widehat)\s*\{([^{}]*)\}|\\(?:hat|widehat)\s*(\\?[A-Za-z])",
-               lambda m: (m.group(1) or m.group(2)) + "\u0302", t)
-    t = re.sub(r"\\(?:bar|overline)\s*\{([^{}]*)\}", "\\1\u0304", t)
-    t = re.sub(r"\\tilde\s*\{([^{}]*)\}|\\tilde\s*([A-Za-z])", lambda m: (m.group(1) or m.group(2)) + "\u0303", t)
-    t = re.sub(r"\\[dt]?frac\s*\{([^{}]*)\}\s*\{([^{}]*)\}", r"(\1)/(\2)", t)
-    t = re.sub(r"\\sqrt\s*\{([^{}]*)\}", r"√(\1)", t)
-    t = re.sub(r"\\(?:mathrm|mathbf|mathcal|mathbb|text|operatorname|boldsymbol)\s*\{([^{}]*)\}", r"\1", t)
-    t = re.sub(r"\\(left|right|big|Big|bigl|bigr|Bigl|Bigr)\b", "", t)
-    t = re.sub(r"\\([A-Za-z]+)", lambda m: _GREEK.get(m.group(1), ""), t)
-    t = re.sub(r"\^\{([^{}]*)\}|\^(\S)", lambda m: _script(m.group(1) if m.group(1) is not None else m.group(2),
-                                                           _SUP, "^"), t)
-    t = re.sub(r"_\{([^{}]*)\}|_(\S)", lambda m: _script(m.group(1) if m.group(1) is not None else m.group(2),
-                                                         _SUB, "_"), t)
-    t = re.sub(r"\\[,;:!]", " ", t).replace("{", "").replace("}", "").replace("\\\\", " ").replace("\\", "")
-    return " ".join(t.split())
-
 
 def choice_text(node) -> str:
     """Le texte d'une réponse proposée, formules comprises (écrites par :func:`tex_to_text`)."""
@@ -200,12 +184,38 @@ def _ancestors(child, stop):
 # --------------------------------------------------------------------------- numérotation
 
 
+def _chapter_of(node, docname: str) -> str:
+    """Le document (chapitre) d'un nœud. Dans le LaTeX, tout le livre est un seul arbre : Sphinx y range chaque
+    chapitre dans un ``start_of_file`` et marque ses sections de son nom (``section["docname"]``) ; sur le
+    site, chaque page est son propre arbre (``docname``)."""
+    parent = node.parent
+    while parent is not None:
+        if isinstance(parent, nodes.section) and parent.get("docname"):
+            return parent["docname"]
+        parent = parent.parent
+    return docname
+
+
+def _chapter_top(doctree, chapter: str, docname: str):
+    """La section de tête du chapitre ``chapter`` dans ``doctree`` (l'arbre lui-même à défaut)."""
+    for section in doctree.findall(nodes.section):
+        if section.get("docname", docname) == chapter:
+            return section
+    return doctree
+
+
 def _number_questions(app, doctree, docname: str) -> list[quiz_question]:
+    """Numérote les questions de chaque chapitre à partir de 1 (dans le LaTeX aussi, où le livre entier est un
+    seul arbre)."""
     questions = list(doctree.findall(quiz_question))
-    slug = re.sub(r"[^a-z0-9]+", "-", docname.lower()).strip("-")
-    for k, q in enumerate(questions, start=1):
+    counts: dict[str, int] = {}
+    for q in questions:
+        chapter = _chapter_of(q, docname)
+        counts[chapter] = k = counts.get(chapter, 0) + 1
+        slug = re.sub(r"[^a-z0-9]+", "-", chapter.lower()).strip("-")
         q["number"] = k
         q["qid"] = f"kc-quiz-{slug}-{k}"
+        q["chapter"] = chapter
     return questions
 
 
@@ -224,7 +234,12 @@ QUIZ_SCRIPT = r"""
     ".kc-quiz-choice input{margin-right:.5em}" +
     ".kc-quiz-check{margin:.4em 0;padding:.2em .9em;border:1px solid var(--pst-color-border,#888);" +
     "border-radius:4px;background:var(--pst-color-surface,#f6f8fa);color:var(--pst-color-text-base,#222);cursor:pointer}" +
-    ".kc-quiz-check:hover{background:var(--pst-color-on-surface,#eaeef2)}" +
+    // survol : fond et texte contrastés dans les deux modes (le fond « on-surface » du thème était la couleur du texte)
+    ".kc-quiz-check:hover{background:#0a55c0;border-color:#0a55c0;color:#fff}" +
+    "html[data-theme=dark] .kc-quiz-check:hover{background:#79b8ff;border-color:#79b8ff;color:#0d1117}" +
+    ".kc-quiz-why{margin:.2em 0 .4em;padding:.1em .6em;border-left:3px solid var(--pst-color-border,#888)}" +
+    ".kc-quiz-why>p{margin:.2em 0}" +
+    ".kc-quiz-wrong .kc-quiz-why{border-left-color:#cf222e}.kc-quiz-right .kc-quiz-why{border-left-color:#1a7f37}" +
     ".kc-quiz-feedback{font-weight:600;margin:.2em 0}" +
     ".kc-quiz-right .kc-quiz-feedback{color:#1a7f37}" +
     ".kc-quiz-wrong .kc-quiz-feedback{color:#cf222e}" +
@@ -250,8 +265,15 @@ QUIZ_SCRIPT = r"""
     }
     var right = chosen.value === question.getAttribute("data-answer");
     question.classList.add(right ? "kc-quiz-right" : "kc-quiz-wrong");
-    feedback.textContent = right ? "Juste\u00a0!" :
-      "Pas tout \u00e0 fait. R\u00e9essayez, ou d\u00e9pliez l\u2019explication.";
+    // le message de la réponse choisie (l'erreur qu'elle trahit), et lui seul
+    var why = null;
+    question.querySelectorAll(".kc-quiz-why").forEach(function (w) {
+      w.hidden = w.getAttribute("data-choice") !== chosen.value;
+      if (!w.hidden) why = w;
+    });
+    feedback.textContent = right ? "Juste\u00a0!" : (why ?
+      "Pas tout \u00e0 fait\u00a0: voici l\u2019erreur de cette r\u00e9ponse. R\u00e9essayez." :
+      "Pas tout \u00e0 fait. R\u00e9essayez, ou d\u00e9pliez l\u2019explication.");
     if (explanation) {
       explanation.hidden = false;
       explanation.open = right;
@@ -311,6 +333,15 @@ def depart_choice_html(self, node):
 
 
 def visit_explanation_html(self, node):
+    # messages des réponses (hors de l'explication dépliable : on les voit dès qu'on choisit), puis l'explication
+    whys = [c for c in node.children if isinstance(c, quiz_why)]
+    for why in whys:
+        node.remove(why)
+    if whys:
+        self.body.append('<div class="kc-quiz-whys" aria-live="polite">')
+        for why in whys:
+            why.walkabout(self)
+        self.body.append("</div>")
     if not node.children:
         raise nodes.SkipNode
     self.body.append('<details class="kc-quiz-explanation" hidden><summary>Explication</summary>')
@@ -320,13 +351,23 @@ def depart_explanation_html(self, node):
     self.body.append("</details>")
 
 
+def visit_why_html(self, node):
+    self.body.append(f'<div class="kc-quiz-why" data-choice="{node["index"]}" hidden>')
+
+
+def depart_why_html(self, node):
+    self.body.append("</div>")
+
+
 # --------------------------------------------------------------------------- autres sorties (LaTeX…)
 
 
-def _as_plain_nodes(app, doctree, questions: list[quiz_question]) -> None:
-    """Remplace chaque quiz par des listes ordinaires et regroupe les réponses en fin de chapitre."""
-    answers = []
+def _as_plain_nodes(app, doctree, questions: list[quiz_question], docname: str = "") -> None:
+    """Remplace chaque quiz par des listes ordinaires et regroupe les réponses à la fin de **son** chapitre
+    (le LaTeX du livre est un seul arbre : un intertitre « Réponses du quiz » par chapitre)."""
+    answers: dict[str, list] = {}
     for node in list(doctree.findall(quiz)):
+        chapter = next((q["chapter"] for q in node.children if isinstance(q, quiz_question)), docname)
         rubric = nodes.rubric(text=node["title"] or "Quiz")
         listing = nodes.enumerated_list(enumtype="arabic", prefix="", suffix=".")
         for q in [c for c in node.children if isinstance(c, quiz_question)]:
@@ -343,18 +384,29 @@ def _as_plain_nodes(app, doctree, questions: list[quiz_question]) -> None:
             head = nodes.paragraph()
             head += nodes.strong(text=f"Question {q['number']}{_NBSP}: ({letter}) ")
             head.extend(c.deepcopy() for c in right.children)
-            answers.append([head, *explanation.children])
+            whys = [c for c in explanation.children if isinstance(c, quiz_why)]
+            block = [head, *[c for c in explanation.children if not isinstance(c, quiz_why)]]
+            if whys:  # l'erreur de chaque autre réponse, pour le corrigé de l'enseignant
+                listing_whys = nodes.bullet_list()
+                for why in whys:
+                    item = nodes.list_item()
+                    content = [c.deepcopy() for c in why.children]
+                    if content and isinstance(content[0], nodes.paragraph):
+                        content[0].insert(0, nodes.emphasis(text=f"({_LETTERS[why['index'] - 1]}){_NBSP}: "))
+                    item.extend(content)
+                    listing_whys += item
+                block.append(listing_whys)
+            answers.setdefault(chapter, []).append(block)
         node.replace_self([rubric, listing])
-    if not answers:
-        return
-    # un intertitre (rubrique), pas une section : ni numéro ni entrée dans la table des matières, et la
-    # page d'accueil, dont LaTeX aplatit les sections, n'en fait pas une « partie » avant le cours
-    heading = nodes.rubric(text="Réponses du quiz", ids=["kc-quiz-reponses"])
-    top = next(iter(doctree.findall(nodes.section)), None)
-    target = top if top is not None else doctree
-    target.append(heading)
-    for block in answers:
-        target.extend(block)
+    for chapter, blocks in answers.items():
+        # un intertitre (rubrique), pas une section : ni numéro ni entrée dans la table des matières, et la
+        # page d'accueil, dont LaTeX aplatit les sections, n'en fait pas une « partie » avant le cours
+        slug = re.sub(r"[^a-z0-9]+", "-", chapter.lower()).strip("-")
+        heading = nodes.rubric(text="Réponses du quiz", ids=[f"kc-quiz-reponses-{slug}"])
+        target = _chapter_top(doctree, chapter, docname)
+        target.append(heading)
+        for block in blocks:
+            target.extend(block)
 
 
 def _resolve(app, doctree, docname: str) -> None:
@@ -362,7 +414,7 @@ def _resolve(app, doctree, docname: str) -> None:
     if not questions:
         return
     if app.builder.format != "html":
-        _as_plain_nodes(app, doctree, questions)
+        _as_plain_nodes(app, doctree, questions, docname)
 
 
 def _add_script(app, pagename, templatename, context, doctree) -> None:
@@ -378,6 +430,7 @@ def setup(app):
     app.add_node(quiz_choices, html=(visit_choices_html, depart_choices_html))
     app.add_node(quiz_choice, html=(visit_choice_html, depart_choice_html))
     app.add_node(quiz_explanation, html=(visit_explanation_html, depart_explanation_html))
+    app.add_node(quiz_why, html=(visit_why_html, depart_why_html))
     app.add_directive("quiz", QuizDirective)
     app.add_directive("question", QuestionDirective)
     app.connect("doctree-resolved", _resolve)

@@ -214,7 +214,7 @@
     if (search && search.makeSearchSummary && !search.kcReadable) {
       var original = search.makeSearchSummary;
       search.makeSearchSummary = function (htmlText, keywords, anchor) {
-        return original.call(this, readableMath(htmlText), keywords, anchor);
+        return original.call(this, articleOnly(readableMath(htmlText)), keywords, anchor);
       };
       search.kcReadable = true;
     }
@@ -253,11 +253,13 @@
     t = t.replace(/\\[dt]?frac\s*\{([^{}]*)\}\s*\{([^{}]*)\}/g, "($1)/($2)");
     t = t.replace(/\\sqrt\s*\{([^{}]*)\}/g, "√($1)");
     t = t.replace(/\\(?:mathrm|mathbf|mathcal|mathbb|text|operatorname|boldsymbol)\s*\{([^{}]*)\}/g, "$1");
+    t = t.replace(/\\(?:begin|end)\s*\{[^{}]*\}(?:\{[^{}]*\})?/g, " ");  // environnements (aligned…)
     t = t.replace(/\\(left|right|big|Big|bigl|bigr|Bigl|Bigr)\b/g, "");
     t = t.replace(/\\([A-Za-z]+)/g, function (m, name) { return GREEK[name] !== undefined ? GREEK[name] : ""; });
     t = t.replace(/\^\{([^{}]*)\}|\^(\S)/g, function (m, a, b) { return toScript(a !== undefined ? a : b, SUP, "^"); });
     t = t.replace(/_\{([^{}]*)\}|_(\S)/g, function (m, a, b) { return toScript(a !== undefined ? a : b, SUB, "_"); });
     t = t.replace(/\\[,;:!]/g, " ").replace(/[{}]/g, "").replace(/\\\\/g, " ").replace(/\\/g, "");
+    t = t.replace(/&/g, " ");  // colonnes d'alignement
     return t.replace(/\s+/g, " ").trim();
   }
   window.kcTexToText = texToText;
@@ -279,4 +281,21 @@
     });
   }
   window.kcReadableMath = readableMath;
+
+  // L'extrait d'un résultat de recherche ne lit que l'article de la page : ni sa table des matières (barre
+  // latérale, menu « Contenu »), ni l'en-tête, ni le bloc « Importations du chapitre », ni les liens
+  // « précédent / suivant » (Sphinx lit tout l'élément [role=main]).
+  var NOT_CONTENT = [".bd-sidebar-secondary", ".bd-toc", ".bd-header-article", ".header-article",
+    "#pst-page-navigation-heading", ".prev-next-area", ".prev-next-footer", ".kc-imports", ".headerlink",
+    "nav", "footer", ".kc-bokeh-figure script"];
+  function articleOnly(htmlText) {
+    var doc = new DOMParser().parseFromString(htmlText, "text/html");
+    var article = doc.querySelector("article.bd-article") || doc.querySelector("[role=main]");
+    if (!article) return htmlText;
+    NOT_CONTENT.forEach(function (sel) {
+      article.querySelectorAll(sel).forEach(function (el) { el.parentNode.removeChild(el); });
+    });
+    return '<div role="main">' + article.innerHTML + "</div>";
+  }
+  window.kcArticleOnly = articleOnly;
 })();
