@@ -128,14 +128,14 @@ from .likelihood import (
     maximum_likelihood,
 )
 from .tables import Table
-# un seul filtre gaussien, des règles d'intégration (issue 22)
+# un seul filtre gaussien, des règles d'intégration
 from .filters.gaussian import GaussianRule, gaussian_filter, gaussian_filter_runs, gaussian_predict, gaussian_update
 from .filters.extended import Linearization
 from .filters.unscented import UnscentedRule
 from .filters.cubature import CubatureRule, cubature_kalman_filter, cubature_kalman_filter_runs
 from .filters.gauss_hermite import GaussHermiteRule, gauss_hermite_kalman_filter, gauss_hermite_kalman_filter_runs
 from .filters.posterior_linearization import iterated_posterior_linearization_filter
-# filtrer et lisser en parallèle dans le temps (issue 22)
+# filtrer et lisser en parallèle dans le temps
 from .filters.parallel import parallel_kalman_filter, parallel_rts_smoother
 # filtrage invariant sur SE(2) (issue 35)
 from .filters.invariant import (
@@ -147,6 +147,10 @@ from .filters.invariant import (
     se2_standard_ekf_runs,
 )
 from .geometry.lie import se2_adjoint, se2_exp, se2_left_jacobian, se2_log, se2_right_jacobian
+# assimilation de données : Lorenz-63/96, ETKF, DEnKF, LETKF, 3D-Var, interpolation optimale (issue 33)
+from .core.lorenz import lorenz63, lorenz96
+from .filters.ensemble_analysis import denkf_update, etkf_update, gaspari_cohn, letkf_update
+from .filters.variational import optimal_interpolation, three_dimensional_var, var3d_update
 # plusieurs cibles dans le fouillis : porte, association, gestion des pistes, GOSPA (issue 37)
 from .multitarget import (
     GOSPA,
@@ -331,6 +335,16 @@ __all__ = [
     "se2_standard_ekf",
     "se2_invariant_ekf_runs",
     "se2_standard_ekf_runs",
+    # assimilation de données (issue 33)
+    "lorenz96",
+    "lorenz63",
+    "etkf_update",
+    "denkf_update",
+    "gaspari_cohn",
+    "letkf_update",
+    "var3d_update",
+    "three_dimensional_var",
+    "optimal_interpolation",
     # plusieurs cibles dans le fouillis (issue 37)
     "validation_gate",
     "Gate",

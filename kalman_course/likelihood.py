@@ -48,7 +48,7 @@ import scipy.differentiate
 import scipy.linalg
 import scipy.optimize
 
-from .core.linalg import S_NOT_PD, symmetrize
+from .core.linalg import symmetrize
 from .core.models import LinearGaussianModel
 from .core.results import FilterResult, freeze
 from .core.validation import (
@@ -68,8 +68,9 @@ from .filters.diffuse import (
     is_determined,
     masked_innovations,
 )
-from .filters.engine import run_filter
+from .filters.engine import run_filter, run_filter_runs
 from .filters.ensemble import EnsembleFilterResult
+from .filters.imm import IMMResult
 from .filters.kalman import kalman_filter
 from .filters.particle import ParticleFilterResult
 from .filters.smoothers import diffuse_rts_pass, rts_smoother
@@ -101,16 +102,19 @@ def log_likelihood_terms(result: FilterResult) -> np.ndarray:
     :math:`\nu_k^TS_k^{-1}\nu_k = \lVert L_k^{-1}\nu_k\rVert^2`), sur les composantes observées.
 
     Paramètres : ``result`` — :class:`~kalman_course.FilterResult`. Renvoie (T,) : 0 pour un pas sans
-    mesure ; NaN pour un pas observé dont la prédiction n'est pas déterminée (début d'une initialisation diffuse,
-    SRIF parti de :math:`\mathcal R_{xx} = 0`).
+    mesure ou dont la mesure a été rejetée par la porte (``result.rejected`` : le filtre ne l'a pas utilisée,
+    comme une mesure manquante) ; NaN pour un pas observé dont la prédiction n'est pas déterminée (début d'une
+    initialisation diffuse, SRIF parti de :math:`\mathcal R_{xx} = 0`).
 
+    IMM : ses propres termes :math:`\log\sum_j \bar c_j\,\mathcal N(\nu_j; 0, S_j)` (vraisemblance du mélange,
+    ``result.log_likelihood_increments``), et non ceux de la gaussienne de mêmes moments.
     Filtres de Monte-Carlo : le filtre particulaire a sa propre estimation
     :math:`\log\hat p(y_k\mid y_{1:k-1})` (``result.log_likelihood_increments``), rendue telle quelle ;
     l'EnKF n'en a pas, et la formule gaussienne appliquée à ses innovations n'en serait qu'un substitut :
     refusé (:func:`filter_log_likelihood`).
     """
     result = _own_estimate_or_refuse(result, "log_likelihood_terms")
-    if isinstance(result, ParticleFilterResult):
+    if isinstance(result, (ParticleFilterResult, IMMResult)):
         return np.array(result.log_likelihood_increments, dtype=float)
     nu, S, obs = result.innovation, result.S, np.asarray(result.observed, dtype=bool)
     if nu.ndim != 2 or S.shape != nu.shape + nu.shape[-1:]:
@@ -118,10 +122,16 @@ def log_likelihood_terms(result: FilterResult) -> np.ndarray:
             f"« result » doit porter des innovations (T, m) et leurs covariances (T, m, m) ; reçu "
             f"{nu.shape} et {S.shape} (un lot de tirages se traite tirage par tirage)."
         )
-    T = nu.shape[0]
-    out = np.zeros(T)
-    rows = obs.any(axis=1)
-    known = rows & np.isfinite(np.where(obs, nu, 0.0)).all(axis=1)
+    return _prediction_error_terms(nu, S, obs & ~np.asarray(result.rejected)[:, None])
+
+
+def _prediction_error_terms(nu: np.ndarray, S: np.ndarray, obs: np.ndarray) -> np.ndarray:
+    r"""Les termes :math:`\ell_k` (…, T) d'innovations ``nu`` (…, T, m) de covariances ``S`` (…, T, m, m) aux
+    composantes observées ``obs`` (…, T, m) : 0 sans composante observée, NaN si l'innovation observée n'est
+    pas finie (prédiction non déterminée)."""
+    out = np.zeros(obs.shape[:-1])
+    rows = obs.any(axis=-1)
+    known = rows & np.isfinite(np.where(obs, nu, 0.0)).all(axis=-1)
     out[rows & ~known] = np.nan
     if known.any():
         v, S_full = masked_innovations(nu[known], S[known], obs[known])
@@ -145,6 +155,10 @@ def filter_log_likelihood(result: FilterResult) -> float:
       (:func:`log_likelihood_terms`) ;
     * :class:`~kalman_course.filters.diffuse.DiffuseFilterResult` : la vraisemblance diffuse exacte
       :math:`\log L_d` (voir le module), à partir du filtre augmenté ;
+    * :class:`~kalman_course.IMMResult` : la vraisemblance du mélange,
+      :math:`\sum_k\log\sum_j \bar c_j\,\mathcal N(\nu_j; 0, S_j)` (``result.log_likelihood``) ;
+    * un filtre à porte (``gate=p``) : les pas rejetés (``result.rejected``) ne comptent pas, comme des
+      mesures manquantes ;
     * :class:`~kalman_course.ParticleFilterResult` : l'estimation du filtre particulaire lui-même,
       :math:`\log\hat p(y_{1:T}) = \sum_k\log\hat p(y_k\mid y_{1:k-1})` (``result.log_likelihood``) ;
     * :class:`~kalman_course.EnsembleFilterResult` : refusé — l'EnKF n'estime pas la vraisemblance, et la
@@ -155,7 +169,7 @@ def filter_log_likelihood(result: FilterResult) -> float:
     propres innovations et covariances :math:`S_k` (pour l'EKF, la vraisemblance de son modèle linéarisé).
     """
     result = _own_estimate_or_refuse(result, "filter_log_likelihood")
-    if isinstance(result, ParticleFilterResult):
+    if isinstance(result, (ParticleFilterResult, IMMResult)):
         return result.log_likelihood
     if isinstance(result, DiffuseFilterResult):
         return _diffuse_value(result.augmented, result.information[-1], result.information_vector[-1])
@@ -188,18 +202,24 @@ def _own_estimate_or_refuse(result: Any, call: str) -> FilterResult:
     return result
 
 
-def _diffuse_value(augmented: FilterResult, J: np.ndarray, h: np.ndarray) -> float:
+def _diffuse_value(augmented: FilterResult, J: np.ndarray, h: np.ndarray):
     r""":math:`\log L_d` à partir du filtre augmenté et de :math:`J_T`, :math:`h_T` (voir le module) :
-    :math:`\sum_k \ell_k(v_k, S_k) + \tfrac12 h_T^TJ_T^{-1}h_T - \tfrac12\log|J_T|`, par Cholesky de :math:`J_T`."""
-    if not is_determined(J):
+    :math:`\sum_k \ell_k(v_k, S_k) + \tfrac12 h_T^TJ_T^{-1}h_T - \tfrac12\log|J_T|`, par Cholesky de :math:`J_T`.
+    Un lot (``augmented`` de :func:`~kalman_course.filters.engine.run_filter_runs`, ``J`` (N, n, n), ``h``
+    (N, n)) : les N valeurs, (N,)."""
+    det = is_determined(J)
+    if not np.all(det):
+        which = f" pour « models[{int(np.argmin(det))}] »" if np.ndim(det) else ""
         raise KalmanInputError(
-            "Les mesures ne déterminent pas l'état (information J_T singulière : modèle non observable "
+            f"Les mesures ne déterminent pas l'état{which} (information J_T singulière : modèle non observable "
             "ou trop peu de mesures) : la vraisemblance diffuse n'est pas définie."
         )
-    base = float(np.sum(log_likelihood_terms(augmented)))
-    L = scipy.linalg.cholesky(J, lower=True)
-    w = scipy.linalg.solve_triangular(L, h, lower=True)
-    return base + 0.5 * float(w @ w) - float(np.sum(np.log(np.diag(L))))
+    terms = _prediction_error_terms(augmented.innovation, augmented.S, np.asarray(augmented.observed, dtype=bool))
+    L = np.linalg.cholesky(J)
+    w = np.linalg.solve(L, h[..., None])[..., 0]
+    value = (np.sum(terms, axis=-1) + 0.5 * np.sum(w * w, axis=-1)
+             - np.sum(np.log(np.diagonal(L, axis1=-2, axis2=-1)), axis=-1))
+    return float(value) if np.ndim(value) == 0 else value
 
 
 def _prior(x0: Any, P0: Any) -> bool:
@@ -255,96 +275,30 @@ def log_likelihoods(models: Any, y: Any) -> np.ndarray:
     r"""Vraisemblances **diffuses exactes** de plusieurs modèles de mêmes dimensions sur les mêmes mesures,
     calculées en lot (une grille de paramètres, les points d'une hessienne).
 
-    Même calcul que :func:`log_likelihood` sans ``x0`` ni ``P0`` (voir le module), mais la récurrence du
-    filtre augmenté :math:`[a \mid X]` porte sur les ``G`` modèles à la fois (tableaux (G, …)) : à chaque
-    pas, :math:`[a^- \mid X^-] = A[a \mid X]`, :math:`P^- = AP A^T + Q`, puis, si ``y[k]`` est observée,
-    :math:`S = CP^-C^T + R = LL^T` (Cholesky), :math:`[v \mid -E] = [y \mid 0] - C[a^- \mid X^-]`,
-    :math:`K = P^-C^TS^{-1}`, :math:`[a \mid X] = [a^- \mid X^-] + K[v \mid -E]`, :math:`P = P^- - KCP^-`,
-    en cumulant :math:`\sum\log|S_k|`, :math:`\sum v_k^TS_k^{-1}v_k`, :math:`J = \sum E_k^TS_k^{-1}E_k`,
-    :math:`h = \sum E_k^TS_k^{-1}v_k`.
+    Même calcul que :func:`log_likelihood` sans ``x0`` ni ``P0`` (voir le module), par le même filtre
+    augmenté (:func:`~kalman_course.filters.diffuse.diffuse_family`), que le mode en lot du moteur
+    (:func:`~kalman_course.filters.engine.run_filter_runs`) fait tourner sur les ``G`` modèles à la fois : les
+    modèles sont empilés (:class:`~kalman_course.core.models.ModelBatch`, un tirage par modèle, tous sur
+    ``y``), puis :math:`J_T`, :math:`h_T` et :math:`\log L_d` sont formés pour tous les modèles en lot.
 
     Paramètres
     ----------
     models : suite de ``G`` :class:`~kalman_course.LinearGaussianModel` de mêmes ``n`` et ``m``, sans
-        commande.
-    y : (T, m), ou (T,) si m = 1 — ``NaN`` : mesure manquante. Une ligne partiellement observée fait
-        calculer chaque modèle par :func:`log_likelihood` (même résultat, sans le lot).
+        commande (des modèles variables dans le temps sont calculés un à un par :func:`log_likelihood`).
+    y : (T, m), ou (T,) si m = 1 — ``NaN`` : composante manquante (lignes entières ou partielles).
 
     Renvoie (G,) : les :math:`\log L_d` (nats), égales à celles de :func:`log_likelihood` aux arrondis près.
     """
-    models = list(models) if not isinstance(models, LinearGaussianModel) else [models]
-    if not models:
-        raise KalmanInputError("« models » doit contenir au moins un modèle.")
-    for i, model in enumerate(models):
-        check_instance(f"models[{i}]", model, LinearGaussianModel, "la vraisemblance est celle d'un modèle linéaire gaussien")
-    n, m = models[0].n_state, models[0].n_obs
-    for i, model in enumerate(models):
-        if model.n_state != n or model.n_obs != m:
-            raise KalmanInputError(
-                f"« models[{i}] » a n = {model.n_state}, m = {model.n_obs} ; le premier modèle a n = {n}, m = {m} : "
-                "le lot demande des modèles de mêmes dimensions."
-            )
-        if model.B is not None:
-            raise KalmanInputError(f"« models[{i}] » a une commande B : le lot n'en prend pas ; utilisez log_likelihood.")
-    Y = as_measurements("y", y, m)
-    obs = ~np.isnan(Y)
-    full, some = obs.all(axis=1), obs.any(axis=1)
-    if (some & ~full).any() or any(model.time_varying for model in models):
-        # lignes partielles ou modèles variables dans le temps : le calcul modèle par modèle
-        return np.array([log_likelihood(model, Y) for model in models])
-    A = np.stack([model.A for model in models])
-    C = np.stack([model.C for model in models])
-    Q = np.stack([model.Q for model in models])
-    R = np.stack([model.R for model in models])
-    G = len(models)
-    At, Ct = np.swapaxes(A, 1, 2), np.swapaxes(C, 1, 2)
-    xa = None
-    logdet = np.zeros(G)
-    quad = np.zeros(G)
-    J = np.zeros((G, n, n))
-    h = np.zeros((G, n))
-    n_obs = 0
-    for k in range(Y.shape[0]):
-        if xa is None:  # première prédiction : [a⁻ | X⁻] = [0 | I], P⁻ = 0
-            xa = np.zeros((G, n, n + 1))
-            xa[:, :, 1:] = np.eye(n)
-            P = np.zeros((G, n, n))
-        else:
-            xa = A @ xa
-            P = symmetrize(A @ P @ At + Q)
-        if not full[k]:
-            continue
-        V = -(C @ xa)  # [v | -E], (G, m, 1+n)
-        V[:, :, 0] += Y[k]
-        PCt = P @ Ct
-        S = C @ PCt + R
-        try:
-            L = np.linalg.cholesky(S)
-        except np.linalg.LinAlgError:
-            raise KalmanInputError(f"{S_NOT_PD[:-1]} (au pas {k}).") from None
-        W = np.linalg.solve(L, V)  # L⁻¹[v | -E]
-        logdet += 2.0 * np.sum(np.log(np.diagonal(L, axis1=1, axis2=2)), axis=1)
-        w = W[:, :, 0]
-        quad += np.sum(w * w, axis=1)
-        WE = W[:, :, 1:]  # -L⁻¹E
-        J += np.swapaxes(WE, 1, 2) @ WE
-        h -= (np.swapaxes(WE, 1, 2) @ w[:, :, None])[:, :, 0]
-        Kt = np.linalg.solve(np.swapaxes(L, 1, 2), np.linalg.solve(L, np.swapaxes(PCt, 1, 2)))  # Kᵀ = S⁻¹CP⁻ par Cholesky
-        K = np.swapaxes(Kt, 1, 2)
-        xa = xa + K @ V
-        P = symmetrize(P - K @ np.swapaxes(PCt, 1, 2))
-        n_obs += m
-    J = symmetrize(J)
-    det = is_determined(J)
-    if not det.all():
-        raise KalmanInputError(
-            f"Les mesures ne déterminent pas l'état pour « models[{int(np.argmin(det))}] » (information J_T "
-            "singulière : modèle non observable ou trop peu de mesures) : la vraisemblance diffuse n'est pas définie."
-        )
-    LJ = np.linalg.cholesky(J)
-    wJ = np.linalg.solve(LJ, h[:, :, None])[:, :, 0]
-    return (-0.5 * (n_obs * LOG_2PI + logdet + quad) + 0.5 * np.sum(wJ * wJ, axis=1)
-            - np.sum(np.log(np.diagonal(LJ, axis1=1, axis2=2)), axis=1))
+    from .core.models import ModelBatch
+
+    models = [models] if isinstance(models, LinearGaussianModel) else list(models)
+    if any(isinstance(model, LinearGaussianModel) and model.time_varying and model.B is None for model in models):
+        return np.array([log_likelihood(model, y) for model in models])  # un modèle variable : un par un
+    batch = ModelBatch(models)
+    Y = as_measurements("y", y, batch.n_obs)
+    augmented = run_filter_runs(diffuse_family(), batch, np.broadcast_to(Y, (batch.n_models,) + Y.shape), None, None)
+    J, h = diffuse_information(batch, augmented)
+    return _diffuse_value(augmented, J[:, -1], h[:, -1])
 
 
 # --------------------------------------------------------------------------- maximum de vraisemblance
@@ -601,14 +555,15 @@ def _initial_noise_moment(model: LinearGaussianModel, res: FilterResult, x_smoot
 def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.ndarray | None):
     r"""Une itération d'EM : filtre, lisseur (étape E), formules closes (étape M).
 
-    Étape M, avec :math:`\hat x_{k\mid T}`, :math:`P_{k\mid T}`, :math:`P_{k,k-1\mid T}` du lisseur :
+    Étape M, avec :math:`\hat x_{k\mid T}`, :math:`P_{k\mid T}`, :math:`P_{k,k-1\mid T}` du lisseur (un modèle
+    variable dans le temps a ses :math:`A_k, B_k, C_k` ; :math:`Q` et :math:`R` sont constantes) :
 
     .. math::
 
-        Q' = \frac1{N_Q}\sum_k \Big[r_kr_k^T + P_{k\mid T} - P_{k,k-1\mid T}A^T - AP_{k,k-1\mid T}^T
-        + AP_{k-1\mid T}A^T\Big],\quad r_k = \hat x_{k\mid T} - A\hat x_{k-1\mid T} - Bu_{k-1},
+        Q' = \frac1{N_Q}\sum_k \Big[r_kr_k^T + P_{k\mid T} - P_{k,k-1\mid T}A_k^T - A_kP_{k,k-1\mid T}^T
+        + A_kP_{k-1\mid T}A_k^T\Big],\quad r_k = \hat x_{k\mid T} - A_k\hat x_{k-1\mid T} - B_ku_{k-1},
 
-        R' = \frac1T\sum_k \Big[e_ke_k^T + CP_{k\mid T}C^T\Big],\quad e_k = y_k - C\hat x_{k\mid T},
+        R' = \frac1T\sum_k \Big[e_ke_k^T + C_kP_{k\mid T}C_k^T\Big],\quad e_k = y_k - C_k\hat x_{k\mid T},
 
     la somme sur :math:`Q` portant sur les :math:`N_Q` transitions (depuis l'état initial si l'a priori est
     connu, terme calculé par le lissage des bruits, :func:`_initial_noise_moment`, sûr pour un a priori
@@ -635,31 +590,35 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
         augmented = run_filter(diffuse_family(), model, Y, None, None, U)
         J, h = diffuse_information(model, augmented)
         ll = _diffuse_value(augmented, J[-1], h[-1])  # vérifie que J_T est inversible
-        xs, Ps, lag = diffuse_rts_pass(model.A, augmented, J[-1], h[-1])
+        xs, Ps, lag = diffuse_rts_pass(np.asarray(model.sequence("A", Y.shape[0])), augmented, J[-1], h[-1])
         known_prior = False
-    A, C, R = model.A, model.C, model.R
     T, m = Y.shape
-    Bu = np.zeros_like(xs) if U is None else U @ model.B.T
-    # transitions k-1 → k, k = 1…T-1 : E[w wᵀ | y] = r rᵀ + P_{k|T} − P_{k,k-1|T}Aᵀ − A P_{k,k-1|T}ᵀ + A P_{k-1|T} Aᵀ
+    A, C = np.asarray(model.sequence("A", T)), np.asarray(model.sequence("C", T))  # (T, …) : A_k, C_k
+    R = model.R
+    Bu = np.zeros_like(xs) if U is None else (np.asarray(model.sequence("B", T)) @ U[:, :, None])[:, :, 0]
+    # transitions k-1 → k, k = 1…T-1 :
+    # E[w wᵀ | y] = r rᵀ + P_{k|T} − P_{k,k-1|T}A_kᵀ − A_k P_{k,k-1|T}ᵀ + A_k P_{k-1|T} A_kᵀ
     if xs.shape[0] < 2 and not known_prior:
         raise KalmanInputError("Il faut au moins deux pas de mesure pour estimer Q par EM sans a priori.")
-    r = xs[1:] - xs[:-1] @ A.T - Bu[1:]
-    LA = lag[1:] @ A.T
-    terms_Q = r[:, :, None] * r[:, None, :] + Ps[1:] - LA - np.swapaxes(LA, 1, 2) + A @ Ps[:-1] @ A.T
+    Ak, Akt = A[1:], np.swapaxes(A[1:], 1, 2)
+    r = xs[1:] - (Ak @ xs[:-1, :, None])[:, :, 0] - Bu[1:]
+    LA = lag[1:] @ Akt
+    terms_Q = r[:, :, None] * r[:, None, :] + Ps[1:] - LA - np.swapaxes(LA, 1, 2) + Ak @ Ps[:-1] @ Akt
     if known_prior:  # et la transition 0 → 1 depuis l'a priori
-        terms_Q = np.concatenate([_initial_noise_moment(model, res, xs[0], Ps[0])[None], terms_Q])
+        terms_Q = np.concatenate([_initial_noise_moment(model.at(0), res, xs[0], Ps[0])[None], terms_Q])
     Q_new = np.mean(terms_Q, axis=0)
     # mesures
     obs = ~np.isnan(Y)
     terms = np.empty((T, m, m))
     full, none = obs.all(axis=1), ~obs.any(axis=1)
-    e = Y[full] - xs[full] @ C.T  # lignes complètes, d'un bloc
-    terms[full] = e[:, :, None] * e[:, None, :] + C @ Ps[full] @ C.T
+    Cf = C[full]
+    e = Y[full] - (Cf @ xs[full][:, :, None])[:, :, 0]  # lignes complètes, d'un bloc
+    terms[full] = e[:, :, None] * e[:, None, :] + Cf @ Ps[full] @ np.swapaxes(Cf, 1, 2)
     terms[none] = R
     for k in np.flatnonzero(~full & ~none):  # lignes partielles
         o = obs[k]
         io, im = np.flatnonzero(o), np.flatnonzero(~o)
-        Co = C[io]
+        Co = C[k][io]
         e = Y[k, io] - Co.dot(xs[k])
         Eo = np.outer(e, e) + Co.dot(Ps[k]).dot(Co.T)
         Roo, Rmo = R[np.ix_(io, io)], R[np.ix_(im, io)]
@@ -671,7 +630,7 @@ def em_step(model: LinearGaussianModel, Y: np.ndarray, x0: Any, P0: Any, U: np.n
         block[np.ix_(im, im)] = R[np.ix_(im, im)] - W.dot(Rmo.T)
         terms[k] = M.dot(Eo).dot(M.T) + block
     R_new = terms.mean(axis=0)
-    new = LinearGaussianModel(A, C, symmetrize(Q_new), symmetrize(R_new), model.B)
+    new = LinearGaussianModel(model.A, model.C, symmetrize(Q_new), symmetrize(R_new), model.B)
     return ll, new
 
 
@@ -696,7 +655,8 @@ def expectation_maximization(
 
     Paramètres
     ----------
-    model : LinearGaussianModel — point de départ (ses :math:`Q`, :math:`R` initiales).
+    model : LinearGaussianModel — point de départ (ses :math:`Q`, :math:`R` initiales, constantes ; :math:`A`,
+        :math:`B`, :math:`C` peuvent varier dans le temps).
     y : (T, m), ou (T,) si m = 1 ; ``NaN`` : manquante.
     x0, P0 : a priori connu (sinon initialisation diffuse exacte), comme :func:`log_likelihood`.
     u : (T, p), optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
@@ -705,11 +665,12 @@ def expectation_maximization(
     Renvoie un :class:`EMResult`.
     """
     check_instance("model", model, LinearGaussianModel, "EM estime Q et R d'un modèle linéaire gaussien")
-    if model.time_varying:
+    if model.Q.ndim == 3 or model.R.ndim == 3:
+        name = "Q" if model.Q.ndim == 3 else "R"
         raise KalmanInputError(
-            "« model » varie dans le temps : EM estime une seule paire (Q, R) constante et n'accepte qu'un "
-            "modèle constant (pour des pas irréguliers, estimez plutôt la densité du bruit par "
-            "maximum_likelihood)."
+            f"« model » a une covariance « {name} » variable dans le temps : EM estime une seule paire (Q, R) "
+            "constante (A, B et C peuvent varier d'un pas à l'autre) ; pour des pas irréguliers, dont Q dépend, "
+            "estimez plutôt la densité du bruit par maximum_likelihood."
         )
     if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
         raise KalmanInputError(f"« max_iter » doit être un entier ≥ 1 ; reçu {max_iter!r}.")

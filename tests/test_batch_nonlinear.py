@@ -13,7 +13,7 @@ import kalman_course as kc
 from kalman_course.filters.engine import run_filter_runs
 from kalman_course.filters.extended import extended_kalman_filter_runs
 from kalman_course.filters.iterated import iterated_extended_kalman_filter_runs
-from kalman_course.filters.diffuse import diffuse_family
+from kalman_course.filters.square_root_information import srif_family
 from kalman_course.filters.unscented import unscented_kalman_filter_runs
 from kalman_course.scenarios import radar
 from kalman_course.scenarios._motion import simulate_cv
@@ -220,8 +220,8 @@ def test_bad_controls_linear_models_and_families_without_batch_mode_are_refused(
         iterated_extended_kalman_filter_runs(model, np.zeros((3, 4, 1)), np.zeros(2), np.eye(2), np.zeros((3, 1)))
     with pytest.raises(kc.KalmanInputError, match=r"« model » doit être un NonlinearModel ; reçu LinearGaussianModel"):
         unscented_kalman_filter_runs(lin, np.zeros((3, 4, 1)), np.zeros(2), np.eye(2), **UKF)
-    with pytest.raises(kc.KalmanInputError, match="Le filtre de Kalman à initialisation diffuse n'a pas de mode en lot"):
-        run_filter_runs(diffuse_family(), lin, np.zeros((3, 4, 1)), None, None)
+    with pytest.raises(kc.KalmanInputError, match="Le filtre d'information en racine carrée n'a pas de mode en lot"):
+        run_filter_runs(srif_family(), lin, np.zeros((3, 4, 1)), None, None)
 
 
 def test_ukf_batch_errors_name_the_run_and_the_step():

@@ -502,6 +502,9 @@ FRENCH_REFERENCES = {
     "filtre-particulaire": ("leglandcours", "chopin2020", "cappe2005"),
     "enkf": ("legland2011", "bocquet2014"),
     "vraisemblance": ("cappe2005",),
+    # assimilation de données (issue 33)
+    "assimilation-ensemble": ("bocquet2014", "asch2016"),
+    "methodes-variationnelles": ("asch2016", "adao"),
 }
 
 
@@ -691,3 +694,26 @@ def test_readme_speaks_to_lecturers_on_one_screen_and_contributing_holds_the_mac
                     "## Publier le livre : boutons de lancement"):
         assert heading in contributing, heading
     assert "KALMAN_GRID_CACHE" in contributing and "`.ci/run`" in contributing
+
+
+# --------------------------------------------------------------------------- pas d'inverse dans un chapitre (issue 32)
+
+_INVERSE = re.compile(r"\b(?:np|numpy|scipy)\.linalg\.inv\(|\bla\.inv\(")
+
+
+def inverse_problems(text: str) -> list[str]:
+    """Les cellules de code qui forment une inverse (``np.linalg.inv``) : le cours résout (``solve``,
+    Cholesky), il n'inverse jamais."""
+    return [cell.strip().splitlines()[0] for cell in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, re.S)
+            if _INVERSE.search(cell)]
+
+
+def test_inverse_check():
+    bad = "```{code-cell} ipython3\nK = P @ C.T @ np.linalg.inv(S)\n```\n"
+    good = "```{code-cell} ipython3\nK = np.linalg.solve(S, C @ P).T\n```\n"
+    assert inverse_problems(bad) and not inverse_problems(good)
+
+
+@pytest.mark.parametrize("page", TOC)
+def test_no_chapter_forms_an_inverse(page):
+    assert not inverse_problems(_text(page)), f"{page} : {inverse_problems(_text(page))}"

@@ -355,6 +355,13 @@ STOCHASTIC = [
         _nonlinear(m), y, x0, P0, u, n_particles=size, rng=rng)),
     Member("EnKF", lambda m, y, x0, P0, u=None, size=4000, rng=0: kc.ensemble_kalman_filter(
         _nonlinear(m), y, x0, P0, u, n_members=size, rng=rng)),
+    # assimilation de données (issue 33) : l'ETKF et le LETKF de rayon infini tendent aussi vers le KF (le
+    # DEnKF non : sa covariance analysée garde le terme ¼ KHPHᵀKᵀ — tests/test_assimilation.py)
+    Member("ETKF", lambda m, y, x0, P0, u=None, size=4000, rng=0: kc.ensemble_kalman_filter(
+        _nonlinear(m), y, x0, P0, u, n_members=size, rng=rng, method="etkf")),
+    Member("LETKF (rayon infini)", lambda m, y, x0, P0, u=None, size=4000, rng=0: kc.ensemble_kalman_filter(
+        _nonlinear(m), y, x0, P0, u, n_members=size, rng=rng, method="etkf", localization=np.inf,
+        distances=np.zeros((m.n_obs, m.n_state)))),
 ]
 STOCHASTIC_IDS = [f.name for f in STOCHASTIC]
 
@@ -489,6 +496,24 @@ def test_se2_filters_missing_rows_are_prediction_only(member):
 
 
 @pytest.mark.parametrize("member", SE2_MEMBERS, ids=lambda f: f.__name__)
+def test_se2_filters_gated_step_is_the_same_step_with_the_row_missing(member):
+    """La porte, option du moteur, sur les filtres de SE(2) : des positions aberrantes rejetées ; le filtrage à
+    porte égale le même filtrage où ces lignes manquent, log-vraisemblance comprise."""
+    model, _, T0, P0, u = _se2_case(T=60)
+    clean = member(model, np.full((60, 2), np.nan), T0, P0, u)
+    y = clean.position + np.random.default_rng(5).normal(0.0, 0.8, (60, 2))
+    y[[10, 30, 31]] += 40.0
+    gated = member(model, y, T0, P0, u, gate=0.999)
+    assert gated.rejected[[10, 30, 31]].all()
+    holes = y.copy()
+    holes[gated.rejected] = np.nan
+    plain = member(model, holes, T0, P0, u)
+    for field in ("x", "P", "x_pred", "P_pred"):
+        np.testing.assert_allclose(getattr(gated, field), getattr(plain, field), rtol=1e-8, atol=1e-10, err_msg=field)
+    assert kc.filter_log_likelihood(gated) == pytest.approx(kc.filter_log_likelihood(plain), rel=1e-10)
+
+
+@pytest.mark.parametrize("member", SE2_MEMBERS, ids=lambda f: f.__name__)
 @pytest.mark.parametrize("bad, message", BAD_INPUTS[:3] + BAD_INPUTS[7:])
 def test_se2_filters_share_the_engine_errors(member, bad, message):
     model, y, T0, P0, u = _se2_case(T=5)
@@ -498,3 +523,262 @@ def test_se2_filters_share_the_engine_errors(member, bad, message):
         args["u"] = np.zeros((4, 3))
     with pytest.raises(kc.KalmanInputError, match=message):
         member(model, args["y"], T0, P0, args["u"])
+
+
+# --------------------------------------------------------------------------- issue 32 : l'axe « modèle variable
+# dans le temps » pour chaque membre linéaire, et la porte pour chaque membre (gate=p : un pas rejeté est le
+# même pas avec la mesure manquante)
+
+from dense_oracle import batch_log_likelihood, batch_posterior  # noqa: E402
+
+
+def varying_case(seed: int = 0, T: int = 30, n: int = 3, m: int = 2, p: int = 1, partial: bool = True):
+    """Un modèle vraiment variable dans le temps (A_k, B_k, C_k, Q_k, R_k tirées à chaque pas autour d'un
+    modèle stable), ses mesures avec des lignes manquantes (et partielles si ``partial``), un a priori loin
+    de zéro et des commandes."""
+    rng = np.random.default_rng(seed)
+    base = random_model(rng, n, m, p)
+    A0 = 0.9 * np.asarray(base.A) / max(1.0, float(np.max(np.abs(np.linalg.eigvals(base.A)))))
+    A = A0 + 0.1 * rng.standard_normal((T, n, n))
+    C = np.asarray(base.C) + 0.3 * rng.standard_normal((T, m, n))
+    s = rng.uniform(0.5, 2.0, T)
+    Q = s[:, None, None] * np.asarray(base.Q)
+    R = rng.uniform(0.5, 3.0, T)[:, None, None] * np.asarray(base.R)
+    B = np.asarray(base.B) * rng.uniform(0.5, 1.5, (T, 1, 1)) if p else None
+    model = kc.LinearGaussianModel(A, C, Q, R, B=B)
+    u = rng.standard_normal((T, p)) if p else None
+    x0 = 10.0 + rng.standard_normal(n)
+    y = np.array(kc.simulate(model, x0, T, u=u, rng=rng).y)
+    y[[3, 11, 12]] = np.nan
+    if partial:
+        y[[6, 20], 1] = np.nan
+        y[25, 0] = np.nan
+    return model, y, x0, np.diag(rng.uniform(0.5, 2.0, n)), u
+
+
+def filterpy_per_step(model, y, x0, P0, u=None):
+    """La référence indépendante : filterpy, au pas k predict(F=A_k, Q=Q_k, B=B_k, u=u_k) puis
+    update(y_k, R=R_k, H=C_k) sur les seules composantes observées ; x, P, x⁻, P⁻."""
+    from filterpy.kalman import KalmanFilter
+
+    T = len(y)
+    A, Q, C, R = (np.asarray(model.sequence(k, T)) for k in ("A", "Q", "C", "R"))
+    B = np.asarray(model.sequence("B", T)) if model.B is not None else None
+    f = KalmanFilter(dim_x=model.n_state, dim_z=model.n_obs, dim_u=max(model.n_control, 1))
+    f.x, f.P = np.asarray(x0, float).reshape(-1, 1), np.asarray(P0, float).copy()
+    out = [[], [], [], []]
+    for k in range(T):
+        if B is None:
+            f.predict(F=A[k], Q=Q[k])
+        else:
+            f.predict(u=u[k].reshape(-1, 1), B=B[k], F=A[k], Q=Q[k])
+        out[2].append(f.x.ravel().copy())
+        out[3].append(f.P.copy())
+        o = ~np.isnan(y[k])
+        if o.any():
+            f.update(y[k, o].reshape(-1, 1), R=R[k][np.ix_(o, o)], H=C[k][o])
+        out[0].append(f.x.ravel().copy())
+        out[1].append(f.P.copy())
+    return tuple(np.array(a) for a in out)
+
+
+VARYING_FILTERS = {
+    "KF (racine carrée)": lambda m, y, x0, P0, u: kc.kalman_filter(m, y, x0, P0, u),
+    "KF (Joseph)": lambda m, y, x0, P0, u: kc.kalman_filter(m, y, x0, P0, u, form="joseph"),
+    "KF (cours)": lambda m, y, x0, P0, u: kc.kalman_filter(m, y, x0, P0, u, form="textbook"),
+    "KF en lot": lambda m, y, x0, P0, u: kc.kalman_filter_runs(m, y[None], x0, P0, u).run(0),
+    "SRIF (inverse)": lambda m, y, x0, P0, u: kc.square_root_information_filter(m, y, x0, P0, u),
+    "SRIF (joint)": lambda m, y, x0, P0, u: kc.square_root_information_filter(m, y, x0, P0, u, method="joint"),
+    "filtre parallèle": lambda m, y, x0, P0, u: kc.parallel_kalman_filter(m, y, x0, P0, u),
+    "IMM (un régime)": lambda m, y, x0, P0, u: kc.imm_filter([m], y, x0, P0, u, transition=[[1.0]]),
+    "Q adaptative (au repos)": lambda m, y, x0, P0, u: kc.adaptive_kalman_filter(m, y, x0, P0, u, detect=1 - 1e-12),
+}
+
+
+@pytest.mark.parametrize("name", list(VARYING_FILTERS))
+def test_every_linear_filter_on_a_time_varying_model_with_missing_rows(name):
+    """Modèle variable dans le temps (A, B, C, Q, R changent à chaque pas), lignes manquantes et partielles :
+    chaque filtre linéaire égale filterpy pas à pas à 10⁻⁸ relatif (x, P, x⁻, P⁻)."""
+    model, y, x0, P0, u = varying_case()
+    res = VARYING_FILTERS[name](model, y, x0, P0, u)
+    for got, ref in zip((res.x, res.P, res.x_pred, res.P_pred), filterpy_per_step(model, y, x0, P0, u)):
+        np.testing.assert_allclose(got, ref, rtol=1e-8, atol=1e-8 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("smoother", ["rts_smoother", "parallel_rts_smoother"])
+def test_smoothers_on_a_time_varying_model_equal_the_dense_posterior(smoother):
+    """Lisseurs (forme commune : lisseur(model, result, x0, P0, u)) contre l'oracle dense (loi de toute la
+    trajectoire d'un bloc, sans récurrence) : x, P, covariances de décalage, état initial, à 10⁻⁸."""
+    model, y, x0, P0, u = varying_case(1)
+    if smoother == "rts_smoother":
+        sm = kc.rts_smoother(model, kc.kalman_filter(model, y, x0, P0, u), x0, P0, u)
+    else:
+        sm = kc.parallel_rts_smoother(model, kc.parallel_kalman_filter(model, y, x0, P0, u), x0, P0, u)
+    dense = batch_posterior(model, y, u=u, x0=x0, P0=P0)
+    for got, key in ((sm.x, "x"), (sm.P, "P"), (sm.P_lag[1:], "P_lag"), (sm.x_initial, "x_initial"),
+                     (sm.P_initial, "P_initial"), (sm.P_lag[0], "lag0")):
+        ref = dense[key][1:] if key == "P_lag" else dense[key]
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-8 * np.abs(ref).max(), err_msg=key)
+
+
+def test_diffuse_filter_and_smoother_on_a_time_varying_model_equal_the_dense_posterior():
+    """Départ diffus exact sur un modèle variable : chaque estimation filtrée déterminée est la moyenne a
+    posteriori de l'état du pas sachant les mesures jusqu'à lui (oracle dense sur la série tronquée, sans a
+    priori), et le lissage exact est l'oracle dense sur toute la série."""
+    model, y, _, _, _ = varying_case(2, T=20, p=0, partial=False)
+    res = kc.diffuse_kalman_filter(model, y)
+    determined = np.flatnonzero(np.isfinite(res.x).all(axis=1))
+    assert determined.size > 15
+    for k in determined:
+        head = kc.LinearGaussianModel(*(np.asarray(getattr(model, a))[:k + 1] for a in ("A", "C", "Q", "R")))
+        dense = batch_posterior(head, y[:k + 1])
+        np.testing.assert_allclose(res.x[k], dense["x"][-1], rtol=0, atol=1e-8 * np.abs(dense["x"]).max())
+        np.testing.assert_allclose(res.P[k], dense["P"][-1], rtol=0, atol=1e-8 * np.abs(dense["P"][-1]).max())
+    sm = kc.rts_smoother(model, res)
+    dense = batch_posterior(model, y)
+    np.testing.assert_allclose(sm.x, dense["x"], rtol=0, atol=1e-8 * np.abs(dense["x"]).max())
+    np.testing.assert_allclose(sm.P, dense["P"], rtol=0, atol=1e-8 * np.abs(dense["P"]).max())
+    np.testing.assert_allclose(sm.P_lag[1:], dense["P_lag"][1:], rtol=0, atol=1e-8 * np.abs(dense["P"]).max())
+
+
+@pytest.mark.parametrize("prior", [True, False])
+def test_likelihood_on_a_time_varying_model_equals_the_dense_gaussian(prior):
+    """log L d'un modèle variable, lignes manquantes et partielles, a priori connu ou départ diffus exact,
+    contre la loi jointe des mesures calculée d'un bloc (aucune récurrence) ; aussi par le filtre
+    parallèle et par le lot de modèles (log_likelihoods)."""
+    model, y, x0, P0, u = varying_case(3, p=0 if not prior else 1)
+    if prior:
+        ours = kc.log_likelihood(model, y, x0, P0, u)
+        ref = batch_log_likelihood(model, y, u, x0, P0)
+        assert kc.filter_log_likelihood(kc.parallel_kalman_filter(model, y, x0, P0, u)) == pytest.approx(ref, rel=1e-9)
+    else:
+        ours = kc.log_likelihood(model, y)
+        ref = batch_log_likelihood(model, y)
+        np.testing.assert_allclose(kc.likelihood.log_likelihoods([model, model], y), [ref, ref], rtol=1e-9)
+    assert ours == pytest.approx(ref, rel=1e-9)
+
+
+def test_em_step_on_a_time_varying_model_is_the_closed_form_on_the_dense_moments():
+    """EM sur un modèle à A_k, B_k, C_k variables (Q et R constantes, estimées) : l'étape M du paquet égale
+    les formules closes de Shumway et Stoffer appliquées aux moments a posteriori de l'oracle dense (état
+    initial compris), à 10⁻⁸."""
+    model, y, x0, P0, u = varying_case(4, partial=False)
+    model = kc.LinearGaussianModel(model.A, model.C, np.asarray(model.Q)[0], np.asarray(model.R)[0], B=model.B)
+    _, new = kc.likelihood.em_step(model, y, x0, P0, u)
+    dense = batch_posterior(model, y, u=u, x0=x0, P0=P0)
+    T = len(y)
+    A, B, C = (np.asarray(model.sequence(k, T)) for k in ("A", "B", "C"))
+    xs = np.vstack([dense["x_initial"], dense["x"]])
+    Ps = np.concatenate([dense["P_initial"][None], dense["P"]])
+    lags = np.concatenate([dense["lag0"][None], dense["P_lag"][1:]])  # Cov(x_k, x_{k-1}), k = 1…T
+    terms = []
+    for k in range(1, T + 1):
+        r = xs[k] - A[k - 1] @ xs[k - 1] - B[k - 1] @ u[k - 1]
+        terms.append(np.outer(r, r) + Ps[k] - lags[k - 1] @ A[k - 1].T - A[k - 1] @ lags[k - 1].T
+                     + A[k - 1] @ Ps[k - 1] @ A[k - 1].T)
+    Q_ref = np.mean(terms, axis=0)
+    R_terms = []
+    for k in range(T):
+        if np.isnan(y[k]).all():
+            R_terms.append(np.asarray(model.R))
+        else:
+            e = y[k] - C[k] @ dense["x"][k]
+            R_terms.append(np.outer(e, e) + C[k] @ dense["P"][k] @ C[k].T)
+    np.testing.assert_allclose(new.Q, Q_ref, rtol=1e-8, atol=1e-10)
+    np.testing.assert_allclose(new.R, np.mean(R_terms, axis=0), rtol=1e-8, atol=1e-10)
+    em = kc.expectation_maximization(model, y, x0, P0, u, max_iter=30)
+    assert np.all(np.diff(em.history) >= -1e-9)  # la vraisemblance ne décroît jamais
+
+
+def _nonlinear_members():
+    """Les membres gaussiens à porte, sur le modèle linéaire vu comme non linéaire."""
+    def nl(m):
+        return kc.NonlinearModel.from_linear(m)
+    return {
+        "KF (racine carrée)": lambda m, y, x0, P0, u, **o: kc.kalman_filter(m, y, x0, P0, u, **o),
+        "KF (Joseph)": lambda m, y, x0, P0, u, **o: kc.kalman_filter(m, y, x0, P0, u, form="joseph", **o),
+        "KF (cours)": lambda m, y, x0, P0, u, **o: kc.kalman_filter(m, y, x0, P0, u, form="textbook", **o),
+        "EKF": lambda m, y, x0, P0, u, **o: kc.extended_kalman_filter(nl(m), y, x0, P0, u, **o),
+        "UKF": lambda m, y, x0, P0, u, **o: kc.unscented_kalman_filter(nl(m), y, x0, P0, u, alpha=0.5, beta=2.0,
+                                                                      kappa=0.0, **o),
+        "CKF": lambda m, y, x0, P0, u, **o: kc.cubature_kalman_filter(nl(m), y, x0, P0, u, **o),
+        "GHKF": lambda m, y, x0, P0, u, **o: kc.gauss_hermite_kalman_filter(nl(m), y, x0, P0, u, **o),
+        "filtre gaussien (linéarisation)": lambda m, y, x0, P0, u, **o: kc.gaussian_filter(
+            nl(m), y, x0, P0, u, rule=kc.Linearization(), **o),
+        "IMM (un régime)": lambda m, y, x0, P0, u, **o: kc.imm_filter([m], y, x0, P0, u, transition=[[1.0]], **o),
+        "IMM (deux régimes)": lambda m, y, x0, P0, u, **o: kc.imm_filter(
+            [m, kc.LinearGaussianModel(m.A, m.C, 4.0 * np.asarray(m.Q), m.R, B=m.B)], y, x0, P0, u,
+            transition=[[0.9, 0.1], [0.2, 0.8]], **o),
+        "IMM à régimes EKF": lambda m, y, x0, P0, u, **o: kc.imm_filter(
+            [nl(m), nl(kc.LinearGaussianModel(m.A, m.C, 4.0 * np.asarray(m.Q), m.R, B=m.B))], y, x0, P0, u,
+            transition=[[0.9, 0.1], [0.2, 0.8]], **o),
+        "IMM à régimes CKF": lambda m, y, x0, P0, u, **o: kc.imm_filter(
+            [m, kc.LinearGaussianModel(m.A, m.C, 4.0 * np.asarray(m.Q), m.R, B=m.B)], y, x0, P0, u,
+            transition=[[0.9, 0.1], [0.2, 0.8]], rule=kc.CubatureRule(), **o),
+        "Q adaptative": lambda m, y, x0, P0, u, **o: kc.adaptive_kalman_filter(m, y, x0, P0, u, **o),
+    }
+
+
+GATED = _nonlinear_members()
+
+
+@pytest.mark.parametrize("name", list(GATED))
+def test_a_gated_step_is_the_same_step_with_the_row_missing(name):
+    """Porte (option du moteur) : des mesures aberrantes (et une composante aberrante d'une ligne partielle)
+    sont rejetées ; le filtrage à porte égale, à 10⁻⁸, le même filtrage où ces lignes manquent. La
+    log-vraisemblance du filtrage à porte ne compte pas les pas rejetés (elle égale celle du filtrage à
+    trous)."""
+    model, y, x0, P0, u = _case(6, 3, 2, 1, T=60)
+    y[[10, 30, 31]] += 40.0
+    y[45, 1] = np.nan
+    y[45, 0] += 40.0
+    gated = GATED[name](model, y, x0, P0, u, gate=0.999)
+    assert gated.rejected[[10, 30, 31, 45]].all()
+    holes = y.copy()
+    holes[gated.rejected] = np.nan
+    plain = GATED[name](model, holes, x0, P0, u)
+    for field in ("x", "P", "x_pred", "P_pred"):
+        np.testing.assert_allclose(getattr(gated, field), getattr(plain, field), rtol=1e-8, atol=1e-10, err_msg=field)
+    assert kc.filter_log_likelihood(gated) == pytest.approx(kc.filter_log_likelihood(plain), rel=1e-10)
+    # un pas rejeté : gain nul, innovation et S gardées (son NIS se lit)
+    assert not gated.K[10].any() and np.isfinite(gated.innovation[10]).all()
+    assert not plain.rejected.any()
+
+
+@pytest.mark.parametrize("name", [k for k in GATED if k != "Q adaptative"])
+def test_fading_memory_is_the_same_option_on_every_member(name):
+    """Mémoire évanescente (option du moteur) : chaque membre, sur le modèle linéaire, égale la boucle de
+    filterpy avec ``KalmanFilter.alpha`` (P⁻ = α² A P Aᵀ + Q) — l'IMM à deux régimes identiques aussi."""
+    from filterpy.kalman import KalmanFilter
+
+    model, y, x0, P0, u = _case(7, 3, 2, 1, T=40)
+    if name.startswith("IMM") and name != "IMM (un régime)":  # deux régimes identiques : le filtre d'un régime
+        modes = [kc.NonlinearModel.from_linear(model)] * 2 if "EKF" in name else [model, model]
+        res = kc.imm_filter(modes, y, x0, P0, u, transition=[[0.9, 0.1], [0.2, 0.8]], fading=1.05,
+                            rule=kc.CubatureRule() if "CKF" in name else None)
+    else:
+        res = GATED[name](model, y, x0, P0, u, fading=1.05)
+    f = KalmanFilter(dim_x=3, dim_z=2, dim_u=1)
+    f.F, f.H, f.Q, f.R, f.B = (np.array(a) for a in (model.A, model.C, model.Q, model.R, model.B))
+    f.x, f.P, f.alpha = x0.reshape(3, 1).copy(), P0.copy(), 1.05
+    for k in range(len(y)):
+        f.predict(u=u[k].reshape(1, 1))
+        f.update(y[k].reshape(2, 1))
+        np.testing.assert_allclose(res.x[k], f.x.ravel(), rtol=1e-8, atol=1e-8)
+        np.testing.assert_allclose(res.P[k], f.P, rtol=1e-8, atol=1e-8)
+
+
+def test_options_a_member_does_not_have_are_refused_in_french():
+    from kalman_course.filters.engine import run_filter
+    from kalman_course.filters.particle import particle_family
+
+    model, y, x0, P0, _ = _case(1, 3, 2, 0, T=5)
+    nl = kc.NonlinearModel.from_linear(model)
+    with pytest.raises(kc.KalmanInputError, match="« gate » : le filtre particulaire n'a pas de porte"):
+        run_filter(particle_family(50), nl, y, x0, P0, rng=0, gate=0.99)
+    with pytest.raises(kc.KalmanInputError, match="« fading » : le filtre particulaire n'a pas de mémoire"):
+        run_filter(particle_family(50), nl, y, x0, P0, rng=0, fading=1.1)
+    with pytest.raises(kc.KalmanInputError, match="« gate » doit être une probabilité"):
+        kc.cubature_kalman_filter(nl, y, x0, P0, gate=1.5)
+    with pytest.raises(kc.KalmanInputError, match="« fading » doit être un facteur α ≥ 1"):
+        kc.imm_filter([model], y, x0, P0, transition=[[1.0]], fading=0.5)

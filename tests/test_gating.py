@@ -1,5 +1,6 @@
-"""Options du filtre de Kalman pour le pistage : la porte (``gate=p``, ``.rejected``) et la mémoire
-évanescente (``fading=α``, contre ``KalmanFilter.alpha`` de filterpy)."""
+"""Options du moteur pour le pistage, sur le filtre de Kalman : la porte (``gate=p``, ``.rejected``) et la
+mémoire évanescente (``fading=α``, contre ``KalmanFilter.alpha`` de filterpy). Les mêmes options sur chaque
+membre du filtre gaussien et sur l'IMM : tests/test_family.py, tests/test_imm.py."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from filterpy.kalman import KalmanFilter
 
 import kalman_course as kc
 from kalman_course.filters.gating import gate_threshold
+from kalman_course.scenarios._motion import simulate_turning
 
 
 def cv_model(dt=1.0, q=0.5, sigma=3.0):
@@ -91,13 +93,8 @@ def test_a_track_lost_behind_its_own_gate():
     dt = 1.0
     model = cv_model(dt, q=0.01, sigma=2.0)
     T = 80
-    truth = np.zeros((T, 5))
-    x = np.array([0.0, 0.0, 30.0, 0.0, 0.0])
-    for k in range(T):
-        x[4] = 0.0 if k < 20 else 0.12  # virage serré à partir de 20 s
-        x = kc.core.motion.turn_transition(x, dt)
-        truth[k] = x
-    y = truth[:, :2] + np.random.default_rng(3).standard_normal((T, 2)) * 2.0
+    rate = np.where(np.arange(T) < 20, 0.0, 0.12)  # virage serré à partir de 20 s
+    truth, y = simulate_turning(rate, [0.0, 0.0, 30.0, 0.0], dt, 2.0, np.random.default_rng(3))
     res = kc.kalman_filter(model, y, [0.0, 0.0, 30.0, 0.0], np.eye(4), gate=0.99)
     assert not res.rejected[:20].any()
     first = int(np.argmax(res.rejected))
@@ -144,13 +141,8 @@ def test_fading_memory_follows_a_manoeuvre_faster():
     """Même retard qu'au test de la porte, sans porte : l'oubli réduit l'erreur pendant le virage."""
     model = cv_model(1.0, q=0.01, sigma=2.0)
     T = 60
-    x = np.array([0.0, 0.0, 30.0, 0.0, 0.0])
-    truth = np.zeros((T, 5))
-    for k in range(T):
-        x[4] = 0.0 if k < 20 else 0.08
-        x = kc.core.motion.turn_transition(x, 1.0)
-        truth[k] = x
-    y = truth[:, :2] + np.random.default_rng(6).standard_normal((T, 2)) * 2.0
+    rate = np.where(np.arange(T) < 20, 0.0, 0.08)
+    truth, y = simulate_turning(rate, [0.0, 0.0, 30.0, 0.0], 1.0, 2.0, np.random.default_rng(6))
     err = {a: np.sqrt(np.mean(np.sum((kc.kalman_filter(model, y, [0, 0, 30, 0], np.eye(4), fading=a).x[20:, :2]
                                       - truth[20:, :2]) ** 2, axis=1))) for a in (1.0, 1.1)}
     assert err[1.1] < 0.6 * err[1.0], err  # mesuré : 16,6 m contre 34,9 m

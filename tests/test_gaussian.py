@@ -1,5 +1,5 @@
-"""Un seul filtre gaussien, des règles d'intégration : l'EKF et l'UKF en sont des membres (mêmes résultats
-que leurs fonctions) ; le CKF contre l'UKF (α = 1, β = 0, κ = 0) et contre ``CubatureKalmanFilter`` de
+"""Un seul filtre gaussien, des règles d'intégration : la règle de linéarisation contre l'EKF de filterpy, la
+règle unscented contre l'UKF de filterpy (filtres et pas isolés) ; le CKF contre l'UKF (α = 1, β = 0, κ = 0) et contre ``CubatureKalmanFilter`` de
 filterpy ; le GHKF contre les moments gaussiens exacts de :math:`x^3` (forme close) et contre scipy ;
 les sommes centrées de l'UKF loin de zéro ; erreurs françaises. (L'égalité avec le filtre de Kalman sur un
 modèle linéaire est dans tests/test_family.py.)"""
@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import scipy.stats
 from reference_ckf import filterpy_cubature_filter
+from reference_ukf import filterpy_unscented_filter
 
 import kalman_course as kc
 from kalman_course.filters.gauss_hermite import gauss_hermite_points
@@ -31,58 +32,90 @@ def _tag_model_and_data(n_steps=120):
 # --------------------------------------------------------------------------- l'EKF et l'UKF sont des membres
 
 
+def filterpy_ekf(model, y, x0, P0):
+    """La référence indépendante de la règle de linéarisation : ``ExtendedKalmanFilter`` de filterpy, prédiction
+    x = f(x), P = FPFᵀ + Q écrite ici (filterpy n'a pas de f non linéaire), correction de filterpy (forme de
+    Joseph) avec la jacobienne et h du modèle ; ligne NaN : prédiction seule."""
+    from filterpy.kalman import ExtendedKalmanFilter
+
+    n, m = model.n_state, model.n_obs
+    ekf = ExtendedKalmanFilter(dim_x=n, dim_z=m)
+    ekf.x, ekf.P = np.array(x0, dtype=float).reshape(n, 1), np.array(P0, dtype=float)
+    ekf.Q, ekf.R = np.array(model.Q), np.array(model.R)
+    xs, Ps = [], []
+    for yk in np.asarray(y, dtype=float).reshape(len(y), m):
+        F = model.transition_jacobian(ekf.x.ravel())
+        ekf.x = model.transition(ekf.x.ravel()).reshape(n, 1)
+        ekf.P = F @ ekf.P @ F.T + ekf.Q
+        if not np.isnan(yk).all():
+            ekf.update(yk.reshape(m, 1), lambda x: model.observation_jacobian(x.ravel()),
+                       lambda x: model.observe(x.ravel()).reshape(m, 1))
+        xs.append(ekf.x.ravel().copy())
+        Ps.append(ekf.P.copy())
+    return np.array(xs), np.array(Ps)
+
+
 @pytest.mark.parametrize("joseph", [False, True])
-def test_ekf_is_the_gaussian_filter_with_the_linearization_rule(joseph):
+def test_the_linearization_rule_is_filterpy_extended_kalman_filter(joseph):
+    """``gaussian_filter(rule=Linearization())``, un tirage et en lot (lignes manquantes comprises), contre
+    l'EKF de filterpy (sa correction est la forme de Joseph ; la forme courte lui est égale à l'arrondi
+    près)."""
     model, data = pendulum.pendulum_model(), pendulum.pendulum_data(150)
     y = np.array(data.y)
     y[[5, 6, 40]] = np.nan
     ours = kc.gaussian_filter(model, y, data.x0, data.P0, rule=kc.Linearization(), joseph=joseph)
-    _same(ours, kc.extended_kalman_filter(model, y, data.x0, data.P0, joseph=joseph), rtol=0, atol=0)
+    x_ref, P_ref = filterpy_ekf(model, y, data.x0, data.P0)
+    np.testing.assert_allclose(ours.x, x_ref, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(ours.P, P_ref, rtol=0, atol=1e-12)
     Y = np.stack([y, np.array(data.y)])
     runs = kc.gaussian_filter_runs(model, Y, data.x0, data.P0, rule=kc.Linearization(), joseph=joseph)
-    _same(runs, kc.extended_kalman_filter_runs(model, Y, data.x0, data.P0, joseph=joseph), rtol=0, atol=0)
+    for i in range(2):
+        x_ref, P_ref = filterpy_ekf(model, Y[i], data.x0, data.P0)
+        np.testing.assert_allclose(runs.run(i).x, x_ref, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(runs.run(i).P, P_ref, rtol=0, atol=1e-12)
 
 
-def test_ekf_joseph_form_written_with_the_cross_covariance_is_joseph():
-    """P⁻ − KP_xyᵀ − P_xyKᵀ + KSKᵀ = (I − KH)P⁻(I − KH)ᵀ + KRKᵀ pour P_xy = P⁻Hᵀ (forme de filterpy)."""
-    from filterpy.kalman import ExtendedKalmanFilter
-
-    model, data = pendulum.pendulum_model(), pendulum.pendulum_data(60)
-    ours = kc.extended_kalman_filter(model, data.y, data.x0, data.P0, joseph=True)
-    ekf = ExtendedKalmanFilter(dim_x=2, dim_z=1)
-    ekf.x, ekf.P = np.array(data.x0, dtype=float).reshape(2, 1), np.array(data.P0, dtype=float)
-    ekf.Q, ekf.R = np.array(model.Q), np.array(model.R)
-    for k, yk in enumerate(np.asarray(data.y)):
-        ekf.F = model.transition_jacobian(ekf.x.ravel())
-        ekf.x = model.transition(ekf.x.ravel()).reshape(2, 1)
-        ekf.P = ekf.F @ ekf.P @ ekf.F.T + ekf.Q
-        ekf.update(np.reshape(yk, (1, 1)), lambda x: model.observation_jacobian(x.ravel()),
-                   lambda x: model.observe(x.ravel()).reshape(1, 1))
-        np.testing.assert_allclose(ours.x[k], ekf.x.ravel(), rtol=0, atol=1e-10)
-        np.testing.assert_allclose(ours.P[k], ekf.P, rtol=0, atol=1e-12)
-
-
-def test_ukf_is_the_gaussian_filter_with_the_unscented_rule():
+def test_the_unscented_rule_is_filterpy_unscented_kalman_filter():
+    """``gaussian_filter(rule=UnscentedRule(α, β, κ))`` contre ``UnscentedKalmanFilter`` de filterpy (points
+    de van der Merwe), sur le tag (quatre distances)."""
     model, data = _tag_model_and_data()
-    rule = kc.UnscentedRule(0.1, 2.0, -1.0)
-    ours = kc.gaussian_filter(model, data.y, data.x0, data.P0, rule=rule)
-    _same(ours, kc.unscented_kalman_filter(model, data.y, data.x0, data.P0, alpha=0.1, beta=2.0, kappa=-1.0),
-          rtol=0, atol=0)
+    ours = kc.gaussian_filter(model, data.y, data.x0, data.P0, rule=kc.UnscentedRule(0.1, 2.0, -1.0))
+    ref = filterpy_unscented_filter(model, data.y, data.x0, data.P0, alpha=0.1, beta=2.0, kappa=-1.0)
+    for field in ("x", "P", "x_pred", "P_pred", "innovation", "S"):
+        np.testing.assert_allclose(getattr(ours, field), getattr(ref, field), rtol=1e-8,
+                                   atol=1e-8 * np.abs(getattr(ref, field)).max(), err_msg=field)
 
 
-def test_single_steps_are_the_filter_steps():
+def test_single_steps_against_filterpy():
+    r"""``gaussian_predict`` / ``gaussian_update`` d'un pas, contre filterpy : l'EKF (prédiction et correction de
+    filterpy, jacobiennes du modèle) ; la cubature contre ``UnscentedKalmanFilter`` à α = 1, β = 0, κ = 0 (mêmes
+    points ± √n L, poids 1/2n, point central de poids nul), sa correction partant des points de
+    :math:`(\hat x^-, P^-)`."""
+    from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
+
     model, data = pendulum.pendulum_model(), pendulum.pendulum_data(3)
-    for rule, run in ((kc.Linearization(), lambda: kc.extended_kalman_filter(model, data.y, data.x0, data.P0)),
-                      (kc.CubatureRule(), lambda: kc.cubature_kalman_filter(model, data.y, data.x0, data.P0))):
-        res = run()
-        pred = kc.gaussian_predict(model, data.x0, data.P0, rule=rule)
-        np.testing.assert_array_equal(pred.x, res.x_pred[0])
-        np.testing.assert_array_equal(pred.P, res.P_pred[0])
-        upd = kc.gaussian_update(model, pred.x, pred.P, data.y[0], rule=rule)
-        np.testing.assert_array_equal(upd.x, res.x[0])
-        np.testing.assert_array_equal(upd.P, res.P[0])
-    ekf = kc.ekf_predict(model, data.x0, data.P0)
-    np.testing.assert_array_equal(ekf.P, kc.gaussian_predict(model, data.x0, data.P0, rule=kc.Linearization()).P)
+    y0 = np.asarray(data.y)[0]
+    x_ref, P_ref = filterpy_ekf(model, data.y[:1], data.x0, data.P0)
+    pred = kc.gaussian_predict(model, data.x0, data.P0, rule=kc.Linearization())
+    F = model.transition_jacobian(np.asarray(data.x0, dtype=float))
+    np.testing.assert_allclose(pred.P, F @ data.P0 @ F.T + model.Q, rtol=1e-14, atol=1e-16)
+    upd = kc.gaussian_update(model, pred.x, pred.P, y0, rule=kc.Linearization())
+    np.testing.assert_allclose(upd.x, x_ref[0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(upd.P, P_ref[0], rtol=0, atol=1e-14)
+    points = MerweScaledSigmaPoints(2, alpha=1.0, beta=0.0, kappa=0.0)
+    ukf = UnscentedKalmanFilter(dim_x=2, dim_z=1, dt=1.0, points=points,
+                                fx=lambda x, dt: model.transition(np.asarray(x, dtype=float)),
+                                hx=lambda x: model.observe(np.asarray(x, dtype=float)))
+    ukf.x, ukf.P, ukf.Q, ukf.R = np.array(data.x0, dtype=float), np.array(data.P0, dtype=float), model.Q, model.R
+    ukf.predict()
+    pred = kc.gaussian_predict(model, data.x0, data.P0, rule=kc.CubatureRule())
+    np.testing.assert_allclose(pred.x, ukf.x, rtol=1e-13)
+    np.testing.assert_allclose(pred.P, ukf.P, rtol=1e-12)
+    ukf.sigmas_f = points.sigma_points(ukf.x, ukf.P)  # la correction tire ses points de (x̂⁻, P⁻)
+    ukf.update(y0)
+    upd = kc.gaussian_update(model, pred.x, pred.P, y0, rule=kc.CubatureRule())
+    np.testing.assert_allclose(upd.x, ukf.x, rtol=1e-12)
+    np.testing.assert_allclose(upd.P, ukf.P, rtol=1e-10, atol=1e-14)
 
 
 def test_linearization_and_cubature_moments_by_hand():

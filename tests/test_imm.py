@@ -10,6 +10,7 @@ import pytest
 from filterpy.kalman import IMMEstimator, KalmanFilter
 
 import kalman_course as kc
+from kalman_course.scenarios._motion import simulate_turning
 
 
 def two_modes(dt=1.0, q_quiet=0.05, q_manoeuvre=20.0, sigma=5.0):
@@ -26,14 +27,9 @@ TRANSITION = np.array([[0.97, 0.03], [0.10, 0.90]])
 
 
 def turning_track(T=120, seed=0, sigma=5.0):
-    x = np.array([0.0, 0.0, 60.0, 0.0, 0.0])
-    truth = np.zeros((T, 5))
-    for k in range(T):
-        x[4] = 0.1 if 40 <= k < 70 else 0.0
-        x = kc.core.motion.turn_transition(x, 1.0)
-        truth[k] = x
-    y = truth[:, :2] + np.random.default_rng(seed).standard_normal((T, 2)) * sigma
-    return truth, y
+    """Une cible à 60 m/s qui vire à 0,1 rad/s de 40 à 70 s (le simulateur des scénarios)."""
+    rate = np.where((np.arange(T) >= 40) & (np.arange(T) < 70), 0.1, 0.0)
+    return simulate_turning(rate, [0.0, 0.0, 60.0, 0.0], 1.0, sigma, np.random.default_rng(seed))
 
 
 def _no_information(imm, m):
@@ -191,12 +187,185 @@ def test_modes_of_different_dimensions_are_refused():
         kc.imm_filter(a, np.zeros((3, 2)), np.zeros(4), np.eye(4), transition=np.eye(1))
 
 
-def test_imm_result_is_immutable_and_shaped():
+def test_imm_modes_and_most_likely_mode_equal_filterpy():
+    """Chaque régime (estimation et covariance) et le régime le plus probable, contre IMMEstimator ; le
+    résultat est immuable."""
     models = two_modes()
-    _, y = turning_track(T=10)
-    res = kc.imm_filter(models, y, np.zeros(4), np.eye(4) * 100.0, transition=TRANSITION)
-    assert res.mu.shape == (10, 2) and res.x_modes.shape == (10, 2, 4) and res.P_modes.shape == (10, 2, 4, 4)
-    assert res.mode.shape == (10,)
+    _, y = turning_track(T=80, seed=2)
+    x0, P0 = np.zeros(4), np.eye(4) * 100.0
+    res = kc.imm_filter(models, y, x0, P0, transition=TRANSITION)
+    filters = []
+    for model in models:
+        f = KalmanFilter(dim_x=4, dim_z=2)
+        f.F, f.H, f.Q, f.R = (np.array(a) for a in (model.A, model.C, model.Q, model.R))
+        f.x, f.P = x0.reshape(4, 1).copy(), P0.copy()
+        filters.append(f)
+    imm = IMMEstimator(filters, np.array([0.5, 0.5]), TRANSITION.copy())
+    for k, z in enumerate(y):
+        imm.predict()
+        imm.update(z.reshape(2, 1))
+        for j, f in enumerate(imm.filters):
+            np.testing.assert_allclose(res.P_modes[k, j], f.P, rtol=1e-9, atol=1e-9)
+            np.testing.assert_allclose(res.x_modes[k, j], f.x.ravel(), rtol=1e-9, atol=1e-9)
+        assert res.mode[k] == int(np.argmax(imm.mu))
     with pytest.raises(ValueError):
         res.mu[0, 0] = 0.3
     copy.deepcopy(res)
+
+
+# --------------------------------------------------------------------------- vraisemblance du mélange
+
+
+def filterpy_mixture_log_likelihood(imm, y):
+    """Σ_k log Σ_j c̄_j ℓ_j avec les vraisemblances ℓ_j que calcule chaque filtre de filterpy à sa correction
+    (``f.likelihood``) et les probabilités prédites c̄ d'IMMEstimator : une référence indépendante."""
+    total = 0.0
+    for z in y:
+        imm.predict()
+        cbar = imm.cbar.copy()
+        if np.isnan(z).all():
+            _no_information(imm, len(z))
+            continue
+        imm.update(z.reshape(-1, 1))
+        total += np.log(sum(c * f.likelihood for c, f in zip(cbar, imm.filters)))
+    return total
+
+
+def test_imm_log_likelihood_is_the_mixture_likelihood():
+    """filter_log_likelihood(imm) = Σ_k log Σ_j c̄_j N(ν_j; 0, S_j), contre filterpy (une ligne manquante
+    comprise) — et non la vraisemblance de la gaussienne de mêmes moments (innovation et S du résultat),
+    qui est plus petite ici (mesuré : −139,03 contre −139,60 sur les 20 premiers pas)."""
+    models = two_modes()
+    _, y = turning_track(T=60, seed=8)
+    y[25] = np.nan
+    x0, P0 = np.array([0.0, 0.0, 60.0, 0.0]), np.diag([25.0, 25.0, 10.0, 10.0])
+    res = kc.imm_filter(models, y, x0, P0, transition=TRANSITION, mu0=[0.9, 0.1])
+    filters = []
+    for model in models:
+        f = KalmanFilter(dim_x=4, dim_z=2)
+        f.F, f.H, f.Q, f.R = (np.array(a) for a in (model.A, model.C, model.Q, model.R))
+        f.x, f.P = x0.reshape(4, 1).copy(), P0.copy()
+        filters.append(f)
+    ref = filterpy_mixture_log_likelihood(IMMEstimator(filters, np.array([0.9, 0.1]), TRANSITION.copy()), y)
+    assert kc.filter_log_likelihood(res) == pytest.approx(ref, rel=1e-10)
+    assert res.log_likelihood_increments[25] == 0.0
+    moments = kc.FilterResult(x=res.x, P=res.P, x_pred=res.x_pred, P_pred=res.P_pred, K=res.K,
+                              innovation=res.innovation, S=res.S, observed=res.observed, n_iter=res.n_iter)
+    assert abs(kc.filter_log_likelihood(moments) - ref) > 0.1  # l'ancien nombre, qui voulait dire autre chose
+    np.testing.assert_array_equal(kc.log_likelihood_terms(res), res.log_likelihood_increments)
+
+
+# --------------------------------------------------------------------------- régimes non linéaires
+
+
+def cv_ct_modes(dt=1.0, sigma=5.0):
+    """Vitesse constante (linéaire, ω ignorée) et virage coordonné (non linéaire) sur l'état
+    [x, y, vx, vy, ω] : l'IMM de pistage classique."""
+    A, Q = kc.constant_velocity(dt, 0.1, dim=2)
+    A5, Q5 = np.eye(5), np.zeros((5, 5))
+    A5[:4, :4], Q5[:4, :4], Q5[4, 4] = A, Q, 1e-6
+    cv = kc.LinearGaussianModel(A5, np.eye(5)[:2], Q5, sigma**2 * np.eye(2))
+    ct = kc.coordinated_turn(dt, 0.1, 1e-3, sigma**2 * np.eye(2))
+    return cv, ct
+
+
+def filterpy_ekf_modes(models, x0, P0):
+    """Les régimes pour IMMEstimator : ExtendedKalmanFilter de filterpy, predict() écrit ici
+    (x = f(x), P = FPFᵀ + Q), update(z) celui de filterpy avec la jacobienne de h."""
+    from filterpy.kalman import ExtendedKalmanFilter
+
+    class Mode(ExtendedKalmanFilter):
+        def __init__(self, model):
+            super().__init__(dim_x=model.n_state, dim_z=model.n_obs)
+            self.model = model
+            self.Q, self.R = np.array(model.Q), np.array(model.R)
+            self.x, self.P = np.asarray(x0, float).reshape(-1, 1).copy(), np.asarray(P0, float).copy()
+
+        def predict(self, u=None):
+            x = self.x.ravel()
+            F = self.model.transition_jacobian(x)
+            self.x = self.model.transition(x).reshape(-1, 1)
+            self.P = F @ self.P @ F.T + self.Q
+
+        def update(self, z):
+            super().update(z, lambda x: self.model.observation_jacobian(x.ravel()),
+                           lambda x: self.model.observe(x.ravel()).reshape(-1, 1))
+
+    return [Mode(kc.NonlinearModel.from_linear(m) if isinstance(m, kc.LinearGaussianModel) else m) for m in models]
+
+
+def test_cv_and_coordinated_turn_imm_with_ekf_modes_equals_filterpy():
+    """L'IMM vitesse constante / virage coordonné à régimes EKF (issue 37) contre IMMEstimator de filterpy
+    sur des ExtendedKalmanFilter : estimation combinée, covariance, probabilités et vraisemblance du mélange
+    à 10⁻⁹ ; le régime « virage » l'emporte pendant le virage."""
+    cv, ct = cv_ct_modes()
+    truth, y = turning_track(T=100, seed=11)
+    x0, P0 = np.array([0.0, 0.0, 60.0, 0.0, 0.0]), np.diag([25.0, 25.0, 10.0, 10.0, 0.01])
+    Pi = np.array([[0.95, 0.05], [0.05, 0.95]])
+    res = kc.imm_filter([cv, ct], y, x0, P0, transition=Pi)
+    imm = IMMEstimator(filterpy_ekf_modes([cv, ct], x0, P0), np.array([0.5, 0.5]), Pi.copy())
+    for k, z in enumerate(y):
+        imm.predict()
+        imm.update(z.reshape(2, 1))
+        np.testing.assert_allclose(res.x[k], imm.x.ravel(), rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(res.P[k], imm.P, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(res.mu[k], imm.mu, rtol=1e-9, atol=1e-12)
+    ref = filterpy_mixture_log_likelihood(
+        IMMEstimator(filterpy_ekf_modes([cv, ct], x0, P0), np.array([0.5, 0.5]), Pi.copy()), y)
+    assert kc.filter_log_likelihood(res) == pytest.approx(ref, rel=1e-10)
+    assert res.mu[50:70, 1].mean() > 0.8 and res.mu[85:, 0].mean() > 0.6
+    cv_only = kc.kalman_filter(cv, y, x0, P0)
+    err = lambda r: np.sqrt(np.mean(np.sum((r.x[45:75, :2] - truth[45:75, :2]) ** 2, axis=1)))  # noqa: E731
+    assert err(res) < 0.7 * err(cv_only)
+
+
+@pytest.mark.parametrize("rule", [kc.Linearization(), kc.CubatureRule(), kc.UnscentedRule(1.0, 2.0, 0.0),
+                                  kc.GaussHermiteRule(order=2)], ids=["EKF", "CKF", "UKF", "GHKF"])
+def test_any_gaussian_member_runs_the_modes_of_a_linear_imm(rule):
+    """Sur des régimes linéaires, chaque membre du filtre gaussien redonne l'IMM de filtres de Kalman
+    (filterpy) : ``rule=`` choisit le membre qui filtre les régimes."""
+    models = two_modes()
+    _, y = turning_track(T=50, seed=4)
+    y[[5, 6]] = np.nan
+    x0, P0 = np.array([0.0, 0.0, 60.0, 0.0]), np.diag([25.0, 25.0, 10.0, 10.0])
+    res = kc.imm_filter(models, y, x0, P0, transition=TRANSITION, rule=rule)
+    x, P, mu, _ = filterpy_imm(models, y, x0, P0, TRANSITION, [0.5, 0.5])
+    np.testing.assert_allclose(res.x, x, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(res.P, P, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(res.mu, mu, rtol=1e-9, atol=1e-12)
+
+
+# --------------------------------------------------------------------------- porte par régime
+
+
+def test_a_measurement_inside_one_mode_gate_is_kept_and_outside_all_is_rejected():
+    """Porte de l'IMM : une par régime. Une mesure hors de la porte du régime calme mais dans celle du régime
+    agité est gardée (le pas égale celui de l'IMM sans porte) ; hors des deux, elle est rejetée (le pas égale
+    celui où la mesure manque) et ne compte pas dans la vraisemblance."""
+    models = two_modes(q_quiet=0.01, q_manoeuvre=200.0, sigma=2.0)
+    _, y = turning_track(T=30, seed=1, sigma=2.0)
+    x0, P0 = np.array([0.0, 0.0, 60.0, 0.0]), np.diag([4.0, 4.0, 1.0, 1.0])
+    plain = kc.imm_filter(models, y, x0, P0, transition=TRANSITION)
+    k = 20
+    assert not plain.rejected.any()
+    y_mid, y_far = y.copy(), y.copy()
+    y_mid[k] += 25.0    # loin pour le régime calme, plausible pour le régime agité
+    y_far[k] += 400.0   # loin pour les deux
+    mid = kc.imm_filter(models, y_mid, x0, P0, transition=TRANSITION, gate=0.999)
+    ref_mid = kc.imm_filter(models, y_mid, x0, P0, transition=TRANSITION)
+    assert not mid.rejected[k]
+    np.testing.assert_allclose(mid.x[k], ref_mid.x[k], rtol=1e-12)
+    from kalman_course.filters.gating import gate_threshold
+    from kalman_course.filters.imm import ModeSet, imm_family
+    # le régime calme seul aurait rejeté la mesure : sa NIS dépasse le seuil
+    quiet = kc.kalman_filter(models[0], y_mid, x0, P0, gate=0.999)
+    assert quiet.rejected[k] and kc.nis(quiet)[k] > gate_threshold(0.999, 2)
+    far = kc.imm_filter(models, y_far, x0, P0, transition=TRANSITION, gate=0.999)
+    holes = y_far.copy()
+    holes[k] = np.nan
+    ref_far = kc.imm_filter(models, holes, x0, P0, transition=TRANSITION)
+    assert far.rejected[k] and not far.rejected[:k].any()
+    np.testing.assert_allclose(far.x, ref_far.x, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(far.mu, ref_far.mu, rtol=1e-10, atol=1e-12)
+    assert kc.filter_log_likelihood(far) == pytest.approx(kc.filter_log_likelihood(ref_far), rel=1e-12)
+    assert ModeSet(models, TRANSITION).linear and imm_family().gating

@@ -229,6 +229,14 @@ def test_se2_prediction_steps_use_these_jacobians(kind):
     np.testing.assert_allclose(Tb[0], T, rtol=1e-12, atol=1e-12)
 
 
+# assimilation de données (issue 33) : h(x) = x de Lorenz-63 et Lorenz-96, jacobienne I
+_l63, _l96 = kc.lorenz63(), kc.lorenz96(8)
+CASES += [
+    _vector_case("Lorenz-63 : H = I", _l63.observe, _l63.observation_jacobian, [np.array([1.5, -1.5, 25.0])]),
+    _vector_case("Lorenz-96 : H = I", _l96.observe, _l96.observation_jacobian, [np.linspace(-3.0, 8.0, 8)]),
+]
+
+
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
 def test_analytic_jacobian_matches_perturbation(case):
     for point in case.points:
@@ -257,3 +265,23 @@ def test_a_wrong_jacobian_fails_this_suite():
     wrong = cam.camera_measurement_jacobian(T, TARGET, CAMERA, "left")
     J_num = central_differences(lambda d: cam.camera_measurement(T @ Exp6(d), TARGET, CAMERA), np.zeros(6))
     assert np.max(np.abs(wrong - J_num)) > 1e-2 * np.max(np.abs(J_num))
+
+
+# --------------------------------------------------------------------------- issue 32 : le virage coordonné
+# turn_jacobian (∂f/∂x de la transition exacte du virage, motion.py) et celle du modèle coordinated_turn qui
+# la reprend, aux vitesses de rotation où ses développements limités prennent le relais (|ωΔt| < 10⁻⁴)
+from kalman_course.core import motion  # noqa: E402
+
+TURN_X = [np.array([10.0, -4.0, 30.0, 12.0, w]) for w in (0.35, -0.8, 3e-5, 0.0, 2e-4)]
+_turn_model = kc.coordinated_turn(1.7, 0.5, 1e-4, np.eye(2) * 25.0)
+CASES_TURN = [
+    _vector_case("virage coordonné : ∂f/∂x (turn_jacobian)", lambda x: motion.turn_transition(x, 1.7),
+                 lambda x: motion.turn_jacobian(x, 1.7), TURN_X),
+    _vector_case("virage coordonné : F du modèle coordinated_turn", lambda x: _turn_model.transition(x, None),
+                 lambda x: _turn_model.transition_jacobian(x, None), TURN_X),
+]
+
+
+@pytest.mark.parametrize("case", CASES_TURN, ids=[c.name for c in CASES_TURN])
+def test_turn_jacobians_match_perturbation(case):
+    test_analytic_jacobian_matches_perturbation(case)

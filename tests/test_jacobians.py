@@ -7,7 +7,6 @@ import pytest
 
 import kalman_course as kc
 from kalman_course.scenarios import radar, tag
-from kalman_course.scenarios._motion import cv_transition
 
 
 def test_numerical_jacobian_closed_form():
@@ -89,7 +88,7 @@ def test_numerical_jacobian_rejects_nan_function():
 
 def test_tag_transition_jacobian_is_the_constant_velocity_matrix():
     data = tag.tag_data()
-    np.testing.assert_allclose(tag.tag_model().transition_jacobian(data.x0), cv_transition(tag.TAG_DT))
+    np.testing.assert_allclose(tag.tag_model().transition_jacobian(data.x0), kc.constant_velocity(tag.TAG_DT, accel_std=0.0).A)
 
 
 def test_tag_jacobian_rows_are_unit_vectors_to_the_anchors():

@@ -68,24 +68,24 @@ def test_scan_gives_every_prefix_of_a_non_commutative_associative_operator(T):
 def test_filtering_operator_is_associative_and_its_prefix_is_the_kalman_filter():
     model, y, x0, P0, u = _case(1, 3, 2, 1, T=6)
     BU = u @ model.B.T
-    el = filtering_elements(model, y, x0, P0, BU)
-    a, b, c = ([e[k:k + 1] for e in el] for k in (1, 2, 3))
+    el = filtering_elements(model, y, x0, P0, BU)  # en colonnes : axe des éléments en dernier
+    a, b, c = ([e[..., k:k + 1] for e in el] for k in (1, 2, 3))
     left = combine_filtering(combine_filtering(a, b), c)
     right = combine_filtering(a, combine_filtering(b, c))
     for L, R in zip(left, right):
         np.testing.assert_allclose(L, R, rtol=1e-11, atol=1e-12)
     # a₁ ⊗ a₂ ⊗ a₃ : F = 0 et (b, Σ) = (x̂₃, P₃) du filtre séquentiel
     kf = kc.kalman_filter(model, y, x0, P0, u)
-    first = [e[0:1] for e in el]
+    first = [e[..., 0:1] for e in el]
     prefix = combine_filtering(combine_filtering(first, a), b)
     assert not np.asarray(prefix[0]).any()
-    np.testing.assert_allclose(prefix[1][0], kf.x[2], rtol=1e-12)
-    np.testing.assert_allclose(prefix[2][0], kf.P[2], rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(prefix[1][..., 0], kf.x[2], rtol=1e-12)
+    np.testing.assert_allclose(prefix[2][..., 0], kf.P[2], rtol=1e-12, atol=1e-14)
 
 
 def test_smoothing_operator_is_associative():
     rng = np.random.default_rng(5)
-    el = [(rng.standard_normal((1, 3, 3)), rng.standard_normal((1, 3)), np.eye(3)[None] * (1 + k)) for k in range(3)]
+    el = [(rng.standard_normal((3, 3, 1)), rng.standard_normal((3, 1)), np.eye(3)[:, :, None] * (1 + k)) for k in range(3)]
     left = combine_smoothing(combine_smoothing(el[0], el[1]), el[2])
     right = combine_smoothing(el[0], combine_smoothing(el[1], el[2]))
     for L, R in zip(left, right):
@@ -128,8 +128,8 @@ def test_parallel_smoother_equals_rts_and_the_dense_posterior():
     model, y, x0, P0, u = _case(3, 3, 2, 1, T=80)
     y[[5, 6, 50]] = np.nan
     y[12, 0] = np.nan
-    ours = kc.parallel_rts_smoother(model, y, x0, P0, u)
-    ref = kc.rts_smoother(model, kc.kalman_filter(model, y, x0, P0, u), x0, P0)
+    ours = kc.parallel_rts_smoother(model, kc.parallel_kalman_filter(model, y, x0, P0, u), x0, P0, u)
+    ref = kc.rts_smoother(model, kc.kalman_filter(model, y, x0, P0, u), x0, P0, u)
     for field in ("x", "P", "G", "P_lag", "x_initial", "P_initial", "G_initial"):
         _close(ours, ref, field)
     dense = batch_posterior(model, y, u=u, x0=x0, P0=P0)
@@ -143,7 +143,7 @@ def test_parallel_smoother_equals_rts_and_the_dense_posterior():
 def test_short_series_and_a_single_step():
     model, y, x0, P0, u = _case(2, 2, 1, 0, T=1)
     _close(kc.parallel_kalman_filter(model, y, x0, P0), kc.kalman_filter(model, y, x0, P0), "P")
-    sm = kc.parallel_rts_smoother(model, y, x0, P0)
+    sm = kc.parallel_rts_smoother(model, kc.parallel_kalman_filter(model, y, x0, P0), x0, P0)
     _close(sm, kc.rts_smoother(model, kc.kalman_filter(model, y, x0, P0), x0, P0), "x_initial")
 
 
@@ -152,7 +152,9 @@ def test_bad_inputs_are_the_kalman_filter_errors():
     with pytest.raises(kc.KalmanInputError, match=r"« y » doit être de forme \(T, 2\)"):
         kc.parallel_kalman_filter(model, np.zeros((5, 3)), x0, P0, u)
     with pytest.raises(kc.KalmanInputError, match="« P0 » doit être"):
-        kc.parallel_rts_smoother(model, y, x0, -P0, u)
+        kc.parallel_kalman_filter(model, y, x0, -P0, u)
+    with pytest.raises(kc.KalmanInputError, match="« P0 » n'est pas l'a priori du filtre"):
+        kc.parallel_rts_smoother(model, kc.parallel_kalman_filter(model, y, x0, P0, u), x0, 2.0 * P0, u)
     with pytest.raises(kc.KalmanInputError, match="« u » doit avoir une commande par pas de temps"):
         kc.parallel_kalman_filter(model, y, x0, P0, u[:3])
     nonlinear = kc.NonlinearModel.from_linear(model)

@@ -617,7 +617,7 @@ def test_tutorial_three_answers_are_the_package_values():
 
 
 def test_tutorial_invariant_answers_are_the_package_values():
-    """TD 6 : Exp(1, 0, π/2), l'adjointe de la pose (90°, (3, 1)) et la correction de l'EKF invariant, écrites à
+    """TD 7 : Exp(1, 0, π/2), l'adjointe de la pose (90°, (3, 1)) et la correction de l'EKF invariant, écrites à
     la main dans la page, contre le paquet (kc.se2_exp, kc.se2_adjoint, se2_invariant_update) et contre des
     calculs indépendants écrits ici (scipy.linalg.expm, formule de Kalman)."""
     import scipy.linalg
@@ -1291,10 +1291,68 @@ def test_capstone_lab_with_its_solutions_equals_the_package_and_each_classic_mis
     assert wrong.student["mu"][:, 1].mean() > run.reference["mu"][:, 1].mean() + 0.05
 
 
+# --------------------------------------------------------------------------- assimilation de données (issue 33)
+
+
+def test_tutorial_four_answers_are_the_package_values():
+    """TD 6 : l'analyse de l'ETKF à deux membres et le taper de Gaspari–Cohn, recalculés par le paquet (et
+    la racine de Cholesky de numpy, pour la question 5)."""
+    text = _page("td-assimilation")
+    E = np.array([[1.0, 0.0], [3.0, 2.0]])
+    Ea = kc.etkf_update(E, [3.5], [[1.0, 0.0]], [[2.0]])
+    assert r"$K = (2,\ 2)^T/(2 + 2) = (0{,}5,\ 0{,}5)^T$" in text
+    assert r"(0{,}5,\ 0{,}5) =" in text and r"(2{,}75,\ 1{,}75)$" in text
+    np.testing.assert_allclose(Ea.mean(axis=0), [2.75, 1.75], atol=1e-12)
+    np.testing.assert_allclose(Ea, [[2.75 - 2**-0.5, 1.75 - 2**-0.5], [2.75 + 2**-0.5, 1.75 + 2**-0.5]], atol=1e-12)
+    assert r"\approx (2{,}043,\ 1{,}043)$" in text and r"\approx (3{,}457,\ 2{,}457)$" in text
+    assert np.round(Ea, 3).tolist() == [[2.043, 1.043], [3.457, 2.457]]
+    np.testing.assert_allclose(np.cov(Ea.T), np.ones((2, 2)), atol=1e-12)  # (I − KH)P
+    # la transformée symétrique : valeurs propres 1 et 2 de M, TA = A/√2
+    M = np.eye(2) + np.outer([-1.0, 1.0], [-1.0, 1.0]) / 2.0
+    assert "M = \\begin{pmatrix}1{,}5 & -0{,}5\\\\ -0{,}5 & 1{,}5\\end{pmatrix}" in text
+    np.testing.assert_allclose(np.linalg.eigvalsh(M), [1.0, 2.0], atol=1e-14)
+    # question 5 : la racine de Cholesky déplace la moyenne
+    L = np.linalg.cholesky(np.linalg.inv(M))
+    LA = L @ (E - E.mean(axis=0))
+    assert "0{,}75 & 0{,}25" in text and r"\approx 0{,}528\,(1, 1)$" in text
+    assert r"$-0{,}338\,(1, 1)$" in text and r"$-0{,}169\,(1, 1)$" in text
+    np.testing.assert_allclose(np.linalg.inv(M), [[0.75, 0.25], [0.25, 0.75]], atol=1e-14)
+    assert round(LA[1, 0], 3) == 0.528 and round(LA.sum(axis=0)[0], 3) == -0.338 and round(LA.mean(axis=0)[0], 3) == -0.169
+    # exercice 2 : le taper de demi-support c = 2
+    rho = kc.gaspari_cohn(np.arange(5.0), 2.0 / 1.82)
+    for fraction, value in (("263/384", rho[1]), ("5/24", rho[2]), ("19/1152", rho[3])):
+        assert fraction in text
+        num, den = map(int, fraction.split("/"))
+        assert Fraction(num, den) == pytest.approx(value, abs=1e-14)
+    assert rho[0] == 1.0 and rho[4] == 0.0
+    assert r"$-3 + 12 + 30 - 160 + 384$" in text or "{-3 + 12 + 30 - 160 + 384}" in text
+    assert r"\tfrac{59}{128}" in text
+    assert r"$1/\rho = 384/263" in text and r"\approx 1{,}46$" in text and round(384 / 263, 2) == 1.46
+    assert r"à $2c = 4$" in text and r"$c = 1{,}82 \times 2 = 3{,}64$" in text and r"$2c = 7{,}28$" in text
+    assert kc.gaspari_cohn(np.array([7.27, 7.29]), 2.0).tolist()[1] == 0.0 and kc.gaspari_cohn(7.27, 2.0) > 0
+    assert "**Durée indicative**" in text
+
+
+def test_etkf_lab_with_the_page_solutions_equals_the_package_and_reports_failures():
+    s = _lab_functions("tp-assimilation", "solution")
+    run = kc.scenarios.assimilation.etkf_lab(s["etkf-update"], s["gaspari-cohn"])
+    assert run.message is None
+    np.testing.assert_allclose(run.student["rmse"], run.reference["rmse"], rtol=1e-8)
+    np.testing.assert_allclose(run.student["taper"], run.reference["taper"], atol=1e-14)
+    assert run.reference["rmse"][20:].mean() < 0.5  # l'ETKF suit la vérité (erreur des observations : 1)
+    blank = cell("def etkf_update(E, y, H, R, inflation):\n    raise NotImplementedError\n", "etkf_update")
+    fig = kc.figures.draw("tp-etkf", etkf_update=blank)
+    assert "pas encore écrite" in fig._suptitle.get_text()
+    assert len(fig.axes[0].get_lines()) == 2  # paquet et erreur des observations : pas de courbe de l'étudiant
+    wrong = practice.exercise("etkf-update").mistakes[0].example  # racine de Cholesky : la moyenne glisse
+    run = kc.scenarios.assimilation.etkf_lab(wrong)
+    assert run.message is None and np.abs(run.student["rmse"] - run.reference["rmse"]).max() > 1e-3
+
+
 # --------------------------------------------------------------------------- plusieurs cibles (issue 37)
 
 
-def test_tutorial_seven_answers_are_the_package_values():
+def test_tutorial_eight_answers_are_the_package_values():
     text = _page("td-plusieurs-cibles")
     step = kc.scenarios.tutorials.pda_by_hand()
     gate = kc.validation_gate(kc.LinearGaussianModel(1.0, 1.0, 0.0, 1.0), [[0.0]], [[[3.0]]], [[1.0], [-2.0]],

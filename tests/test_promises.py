@@ -1321,6 +1321,90 @@ def _invariant_odometry_noise():
         assert 0.5 < r["inv_nees_mean"] < 1.5
 
 
+# =========================================================================== assimilation de données (issue 33)
+
+
+def _inflation(N, lam):
+    return at("assimilation-inflation", n_members=float(N), inflation=float(lam))["rmse_a"][0]
+
+
+@promise("assimilation-ensemble", 1, 1)
+def _assim_no_inflation():
+    run = at("assimilation-inflation", n_members=40.0, inflation=1.0)
+    assert run["rmse_a"][0] > 1.0  # au-dessus de l'erreur des observations : dans la région rouge
+    assert run["rmse"][-50:].min() > 1.0  # et elle ne redescend pas
+    assert run["here_y"][0] == run["rmse_a"][0] and run["here_x"][0] == 1.0
+
+
+@promise("assimilation-ensemble", 1, 2)
+def _assim_little_inflation():
+    none, small, dapper = _inflation(40, 1.0), _inflation(40, 1.02), _inflation(40, 1.06)
+    assert small < none / 5 and dapper < 0.3 and small < 0.3  # divisée par plus de cinq, sous 0,3
+    assert abs(dapper - 0.22) < 0.05  # près du chiffre publié (expérience courte : ± 0,01 d'une graine à l'autre)
+
+
+@promise("assimilation-ensemble", 1, 3)
+def _assim_small_ensemble():
+    for lam in ki.slider_grid("assimilation-inflation").axes[1].values:
+        assert _inflation(10, lam) > 1.0, lam  # la courbe N = 10 reste dans la région de divergence
+
+
+@promise("assimilation-ensemble", 1, 4)
+def _assim_too_much_inflation():
+    values = {lam: _inflation(40, lam) for lam in ki.slider_grid("assimilation-inflation").axes[1].values if lam > 1}
+    assert values[1.2] > 1.3 * min(values.values()) and values[1.2] < 1.0  # l'erreur remonte, sans diverger
+
+
+def _radius(position):
+    return at("assimilation-localisation", radius=float(position))
+
+
+@promise("assimilation-ensemble", 2, 1)
+def _assim_no_localization():
+    run = _radius(5)
+    assert np.isinf(run["radius"][0]) and run["rmse_a"][0] > 1.0  # l'ETKF global à 7 membres diverge
+    assert np.all(run["rho"] == 1.0)  # un taper plat : aucune localisation
+
+
+@promise("assimilation-ensemble", 2, 2)
+def _assim_dapper_radius():
+    run = _radius(2)
+    assert run["radius"][0] == 4.0 and abs(run["rmse_a"][0] - 0.22) < 0.05 and run["rmse_a"][0] < 0.3
+
+
+@promise("assimilation-ensemble", 2, 3)
+def _assim_narrow_and_wide():
+    narrow, good, wide = _radius(0), _radius(2), _radius(4)
+    assert narrow["radius"][0] == 1.0 and wide["radius"][0] == 16.0
+    assert narrow["rmse_a"][0] > 1.2 * good["rmse_a"][0] and narrow["rmse_a"][0] < 1.0  # plus d'erreur, sans diverger
+    assert wide["rmse_a"][0] > 1.0  # le filtre diverge
+    d = ki.slider_spec("assimilation-localisation").fixed["d"]
+    assert np.all(narrow["rho"][d >= 3.64] == 0.0) and wide["rho"][d == 20.0][0] > 0.4  # le taper couvre l'anneau
+
+
+def _density(k):
+    run = at("assimilation-densite", spacing=float(k))
+    return {m: run[f"here_{m}"][0] for m in ("letkf", "3dvar", "oi")}
+
+
+@promise("methodes-variationnelles", 1, 1)
+def _var_all_observed():
+    r = _density(1)
+    assert r["letkf"] < r["3dvar"] < r["oi"] < 1.0
+
+
+@promise("methodes-variationnelles", 1, 2)
+def _var_every_other():
+    r = _density(2)
+    assert r["3dvar"] > r["oi"] > 1.0  # le 3D-Var diverge, plus loin que l'interpolation optimale
+    assert r["letkf"] < 0.5  # le LETKF reste bien sous l'erreur des observations
+
+
+@promise("methodes-variationnelles", 1, 3)
+def _var_one_in_eight():
+    assert _density(8)["letkf"] > 1.0
+
+
 # =========================================================================== plusieurs cibles (issue 37)
 
 

@@ -235,10 +235,12 @@ def test_a_bad_step_is_named():
         kc.LinearGaussianModel(A, [[1.0, 0.0]], Q, R)
 
 
-def test_em_refuses_a_time_varying_model():
+def test_em_refuses_a_time_varying_noise_covariance():
+    """EM estime une Q et une R constantes (A, B, C peuvent varier : tests/test_family.py) ; une Q variable
+    (pas irréguliers) est refusée en français."""
     A, Q = kc.constant_velocity(np.ones(6), 1.0, dim=1)
     model = kc.LinearGaussianModel(A, [[1.0, 0.0]], Q, [[1.0]])
-    with pytest.raises(kc.KalmanInputError, match="varie dans le temps"):
+    with pytest.raises(kc.KalmanInputError, match="covariance « Q » variable dans le temps : EM estime une seule"):
         kc.expectation_maximization(model, np.zeros(6), [0.0, 0.0], np.eye(2))
 
 

@@ -355,6 +355,37 @@ MISUSES = [
      r"« kappa » est obligatoire"),
     ("se3_iterated_filter(y, T0, P0, u)", lambda m, y, r: kc.se3_iterated_filter(np.zeros((3, 8)), np.eye(4), np.eye(6), None),
      r"« model » doit être un CameraPoseModel ; reçu ndarray : le modèle vient d'abord"),
+    # issue 32 : le contrat commun (model, y, x0, P0, u positionnels ; options par leur nom ; lisseurs sur un résultat)
+    ("imm_filter(models, y, x0, P0, Pi)", lambda m, y, r: kc.imm_filter([m, m], y, [1000.0], [[1e7]],
+                                                                        [[0.9, 0.1], [0.2, 0.8]]),
+     r"« transition » manque : .* imm_filter\(models, y, x0, P0, transition=Pi, mu0=…\)\. La matrice donnée en "
+     r"cinquième position, qui est la place des commandes « u », ressemble à une matrice de transition"),
+    ("parallel_rts_smoother(model, y, x0, P0)", lambda m, y, r: kc.parallel_rts_smoother(m, y, [1000.0], [[1e7]]),
+     r"« result » est un tableau \(ndarray\) : tous les lisseurs du paquet lissent la sortie d'un filtre, "
+     r"parallel_rts_smoother\(model, result, x0, P0, u\) ; filtrez d'abord les mesures : "
+     r"parallel_rts_smoother\(model, parallel_kalman_filter\(model, y, x0, P0\), x0, P0\)"),
+    ("rts_smoother(model, y)", lambda m, y, r: kc.rts_smoother(m, list(y)),
+     r"« result » est un tableau \(list\) : .* rts_smoother\(model, kalman_filter\(model, y, x0, P0\), x0, P0\)"),
+    ("unscented_rts_smoother(model, y)", lambda m, y, r: kc.unscented_rts_smoother(
+        kc.NonlinearModel.from_linear(m), y, alpha=1.0, kappa=0.0),
+     r"unscented_rts_smoother\(model, unscented_kalman_filter\(model, y, x0, P0\), x0, P0\)"),
+    ("adaptive_kalman_filter(detect=1.0)", lambda m, y, r: kc.adaptive_kalman_filter(m, y, [1000.0], [[1e7]],
+                                                                                    detect=1.0),
+     r"« detect » doit être une probabilité strictement entre 0 et 1 .* reçu 1\.0"),
+    ("kalman_filter(model, vol, …)", lambda m, y, r: kc.kalman_filter(m, kc.datasets.samu31(), [1000.0], [[1e7]]),
+     r"« y » est un vol \(Flight\), pas un tableau de mesures \(T, 1\) : donnez ses positions, par exemple "
+     r"np\.column_stack\(\[vol\.east, vol\.north\]\)"),
+    ("particle_filter(..., gate=…) par le moteur", lambda m, y, r: __import__(
+        "kalman_course.filters.engine", fromlist=["run_filter"]).run_filter(
+        __import__("kalman_course.filters.particle", fromlist=["particle_family"]).particle_family(20),
+        kc.NonlinearModel.from_linear(m), y, [1000.0], [[1e7]], rng=0, gate=0.99),
+     r"« gate » : le filtre particulaire n'a pas de porte"),
+    ("parallel_kalman_filter, modèle trop court", lambda m, y, r: kc.parallel_kalman_filter(
+        kc.LinearGaussianModel(np.ones((5, 1, 1)), [[1.0]], 1469.1, 15099.0), y, [1000.0], [[1e7]]),
+     r"Le modèle varie dans le temps sur 5 pas .* reçu 100 mesures"),
+    ("imm_filter(rule=\"ukf\")", lambda m, y, r: kc.imm_filter([m], y, [1000.0], [[1e7]], transition=[[1.0]],
+                                                               rule="ukf"),
+     r"« rule » doit être une règle du filtre gaussien .* reçu str"),
 ]
 
 

@@ -35,7 +35,7 @@ from .validation import (
     check_psd,
 )
 
-__all__ = ["LinearGaussianModel", "NonlinearModel", "model_steps"]
+__all__ = ["TimeVarying", "LinearGaussianModel", "ModelBatch", "NonlinearModel", "model_steps", "scale_process_noise"]
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -44,8 +44,53 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return a
 
 
+class TimeVarying:
+    r"""Le protocole des modèles variables dans le temps, commun à :class:`LinearGaussianModel` et aux régimes
+    d'un IMM (:class:`~kalman_course.filters.imm.ModeSet`) : ``_n_steps`` (``None`` : constant) et
+    ``_steps`` (les modèles des pas, calculés une fois) sont posés par la sous-classe, qui donne
+    :meth:`_build_steps` ; le moteur lit :attr:`time_varying` et appelle :meth:`steps` (ou :meth:`at`)."""
+
+    @property
+    def time_varying(self) -> bool:
+        """``True`` si le modèle porte un axe des temps (modèle variable dans le temps)."""
+        return self._n_steps is not None
+
+    @property
+    def n_steps(self) -> int | None:
+        """Longueur ``T`` de l'axe des temps d'un modèle variable (``None`` pour un modèle constant)."""
+        return self._n_steps
+
+    def at(self, k: int):
+        r"""Le modèle constant du pas ``k`` ; le modèle lui-même s'il est constant. Les matrices ne sont pas
+        revérifiées (elles l'ont été à la construction)."""
+        if self._n_steps is None:
+            return self
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < self._n_steps:
+            raise KalmanInputError(
+                f"« k » doit être un indice de pas entier entre 0 et {self._n_steps - 1} ; reçu {k!r}."
+            )
+        return self.steps(self._n_steps)[k]
+
+    def steps(self, T: int) -> list:
+        """Les ``T`` modèles constants des pas d'un modèle variable (calculés une fois, puis gardés) ;
+        une :class:`KalmanInputError` si le modèle n'a pas ``T`` pas."""
+        if self._n_steps is None:
+            return [self] * T
+        if T != self._n_steps:
+            raise KalmanInputError(
+                f"Le modèle varie dans le temps sur {self._n_steps} pas (A, C, Q, R ou B de forme "
+                f"({self._n_steps}, …)) ; reçu {T} mesures. Donnez une ligne de matrices par mesure."
+            )
+        if self._steps is None:
+            object.__setattr__(self, "_steps", self._build_steps(T))
+        return self._steps
+
+    def _build_steps(self, T: int) -> list:  # pragma: no cover - interface
+        raise NotImplementedError
+
+
 @dataclass(frozen=True, eq=False, init=False)
-class LinearGaussianModel:
+class LinearGaussianModel(TimeVarying):
     r"""Système linéaire gaussien discret (notations du cours, :math:`n \to n+1`) :
 
     .. math::
@@ -140,43 +185,10 @@ class LinearGaussianModel:
         """Dimension ``p`` de la commande (0 sans matrice ``B``)."""
         return 0 if self.B is None else self.B.shape[-1]
 
-    @property
-    def time_varying(self) -> bool:
-        """``True`` si au moins une matrice porte un axe des temps (modèle variable dans le temps)."""
-        return self._n_steps is not None
-
-    @property
-    def n_steps(self) -> int | None:
-        """Longueur ``T`` de l'axe des temps d'un modèle variable (``None`` pour un modèle constant)."""
-        return self._n_steps
-
-    def at(self, k: int) -> "LinearGaussianModel":
-        r"""Le modèle constant du pas ``k`` (:math:`A_k, B_k, C_k, Q_k, R_k`) ; le modèle lui-même s'il est
-        constant. Les matrices ne sont pas revérifiées (elles l'ont été à la construction)."""
-        if self._n_steps is None:
-            return self
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < self._n_steps:
-            raise KalmanInputError(
-                f"« k » doit être un indice de pas entier entre 0 et {self._n_steps - 1} ; reçu {k!r}."
-            )
-        return self.steps(self._n_steps)[k]
-
-    def steps(self, T: int) -> list["LinearGaussianModel"]:
-        """Les ``T`` modèles constants des pas d'un modèle variable (calculés une fois, puis gardés) ;
-        une :class:`KalmanInputError` si le modèle n'a pas ``T`` pas."""
-        if self._n_steps is None:
-            return [self] * T
-        if T != self._n_steps:
-            raise KalmanInputError(
-                f"Le modèle varie dans le temps sur {self._n_steps} pas (A, C, Q, R ou B de forme "
-                f"({self._n_steps}, …)) ; reçu {T} mesures. Donnez une ligne de matrices par mesure."
-            )
-        if self._steps is None:
-            pick = lambda a, k: None if a is None else (a[k] if a.ndim == 3 else a)  # noqa: E731
-            steps = [_constant_model(pick(self.A, k), pick(self.C, k), pick(self.Q, k), pick(self.R, k),
-                                     pick(self.B, k)) for k in range(T)]
-            object.__setattr__(self, "_steps", steps)
-        return self._steps
+    def _build_steps(self, T: int) -> list["LinearGaussianModel"]:
+        pick = lambda a, k: None if a is None else (a[k] if a.ndim == 3 else a)  # noqa: E731
+        return [_constant_model(pick(self.A, k), pick(self.C, k), pick(self.Q, k), pick(self.R, k), pick(self.B, k))
+                for k in range(T)]
 
     def sequence(self, name: str, T: int) -> np.ndarray:
         """La matrice ``name`` (``"A"``, ``"B"``, ``"C"``, ``"Q"`` ou ``"R"``) de chacun des ``T`` pas,
@@ -264,12 +276,92 @@ def _each_step(name: str, value: Any, T: int | None, check: Callable[[str, Any],
     return sym
 
 
+@dataclass(frozen=True, eq=False, init=False)
+class ModelBatch:
+    r"""``G`` modèles linéaires gaussiens constants de mêmes dimensions, sans commande, empilés pour être
+    filtrés **ensemble sur les mêmes mesures** par le mode en lot du moteur
+    (:func:`~kalman_course.filters.engine.run_filter_runs`, un tirage par modèle) : ``A`` (G, n, n), ``C``
+    (G, m, n), ``Q`` (G, n, n), ``R`` (G, m, m). Sert aux vraisemblances d'une grille de paramètres
+    (:func:`~kalman_course.likelihood.log_likelihoods`)."""
+
+    A: np.ndarray
+    C: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+
+    def __init__(self, models: Sequence[LinearGaussianModel]) -> None:
+        models = list(models)
+        if not models:
+            raise KalmanInputError("« models » doit contenir au moins un modèle.")
+        for i, model in enumerate(models):
+            if not isinstance(model, LinearGaussianModel):
+                raise KalmanInputError(
+                    f"« models[{i}] » doit être un LinearGaussianModel ; reçu {type(model).__name__} (la "
+                    "vraisemblance est celle d'un modèle linéaire gaussien)."
+                )
+        n, m = models[0].n_state, models[0].n_obs
+        for i, model in enumerate(models):
+            if model.n_state != n or model.n_obs != m:
+                raise KalmanInputError(
+                    f"« models[{i}] » a n = {model.n_state}, m = {model.n_obs} ; le premier modèle a n = {n}, "
+                    f"m = {m} : le lot demande des modèles de mêmes dimensions."
+                )
+            if model.B is not None:
+                raise KalmanInputError(
+                    f"« models[{i}] » a une commande B : le lot n'en prend pas ; utilisez log_likelihood.")
+            if model.time_varying:
+                raise KalmanInputError(
+                    f"« models[{i}] » varie dans le temps : le lot demande des modèles constants ; utilisez "
+                    "log_likelihood modèle par modèle."
+                )
+        for name in ("A", "C", "Q", "R"):
+            object.__setattr__(self, name, _readonly(np.stack([getattr(model, name) for model in models])))
+
+    @property
+    def n_models(self) -> int:
+        """Nombre ``G`` de modèles."""
+        return self.A.shape[0]
+
+    @property
+    def n_state(self) -> int:
+        return self.A.shape[-1]
+
+    @property
+    def n_obs(self) -> int:
+        return self.C.shape[-2]
+
+    n_control = 0
+    time_varying = False
+    B = None
+
+    def __repr__(self) -> str:
+        return f"ModelBatch({self.n_models} modèles, n={self.n_state}, m={self.n_obs})"
+
+
 def _constant_model(A, C, Q, R, B) -> LinearGaussianModel:
     """Un modèle constant fait de matrices déjà vérifiées (les pas d'un modèle variable), sans recopie."""
     model = object.__new__(LinearGaussianModel)
     for name, value in (("A", A), ("C", C), ("Q", Q), ("R", R), ("B", B), ("_n_steps", None), ("_steps", None)):
         object.__setattr__(model, name, value)
     return model
+
+
+def scale_process_noise(model: Any, scale: float) -> Any:
+    r"""Le même modèle avec le bruit d'état :math:`sQ` (``scale`` = :math:`s > 0`), sans revérifier ses
+    matrices : un :class:`LinearGaussianModel` constant (un pas) ou un :class:`NonlinearModel`. Sert à
+    l'adaptation de :math:`Q` du moteur (:class:`~kalman_course.filters.gating.Adaptation`) ; la racine de
+    :math:`sQ` est :math:`\sqrt s\,U_Q`."""
+    if scale == 1.0:
+        return model
+    out = object.__new__(type(model))
+    state = dict(model.__dict__)
+    state.pop("noise_roots", None)  # la racine de sQ, posée plus bas (square_root_blocks ne dépend que de C et R)
+    state["Q"] = _readonly(scale * model.Q)
+    out.__dict__.update(state)
+    if isinstance(model, LinearGaussianModel):
+        U_Q, U_R = model.noise_roots
+        out.__dict__["noise_roots"] = (_readonly(np.sqrt(scale) * U_Q), U_R)
+    return out
 
 
 def model_steps(model: Any, T: int) -> list | None:

@@ -9,7 +9,7 @@ import numpy as np
 from .linalg import gram
 from .validation import KalmanInputError
 
-__all__ = ["FilterResult", "FilterRuns", "FilterHistory", "PoseAliases", "freeze", "freeze_fields"]
+__all__ = ["FilterResult", "AdaptiveResult", "FilterRuns", "FilterHistory", "PoseAliases", "freeze", "freeze_fields"]
 
 
 def freeze(arr: np.ndarray, dtype: type = float) -> np.ndarray:
@@ -109,6 +109,15 @@ class FilterResult:
         seen = int(np.count_nonzero(self.observed.any(axis=-1))) if self.observed.size else 0
         return (f"<{type(self).__name__} : {T} pas, état de dimension {n}, mesure de dimension {m}, "
                 f"{seen} pas avec mesure>")
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class AdaptiveResult(FilterResult):
+    r"""Sortie d'un filtre à :math:`Q` adaptative (option ``adapt`` du moteur,
+    :func:`~kalman_course.adaptive_kalman_filter`) : les champs de :class:`FilterResult` et ``q_scale`` (T,),
+    l'échelle :math:`s_k` de :math:`Q` retenue après la mesure ``y[k]`` (elle sert à prédire le pas suivant)."""
+
+    q_scale: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False, repr=False)

@@ -267,6 +267,12 @@ def as_measurements(name: str, y: Any, m: int) -> np.ndarray:
     if isinstance(y, (list, tuple)):
         missing = np.nan if m == 1 else [np.nan] * m
         y = [missing if row is None else row for row in y]
+    elif hasattr(y, "east") and hasattr(y, "north") and not hasattr(y, "__array__"):
+        raise KalmanInputError(
+            f"« {name} » est un vol ({type(y).__name__}), pas un tableau de mesures (T, {m}) : donnez ses positions, "
+            f"par exemple np.column_stack([vol.east, vol.north]) (m, dans le plan tangent), mesurées aux instants "
+            f"vol.t (le modèle suit ces pas irréguliers)."
+        )
     arr = as_float_array(name, y, allow_nan=True)
     if arr.ndim == 1 and m == 1:
         arr = arr.reshape(-1, 1)

@@ -51,12 +51,16 @@ CHAPTER_TITLES: dict[str, str] = {
     "quel-filtre": "Quel filtre choisir ?",
     "filtrage-parallele": "Filtrer en parallèle dans le temps",
     "filtrage-invariant": "Filtrage invariant sur les groupes de Lie",
-    "td-filtrage-invariant": "TD 6 — L'EKF invariant à la main",
+    "td-filtrage-invariant": "TD 7 — L'EKF invariant à la main",
+    "assimilation-ensemble": "Le filtre d'ensemble en grande dimension",
+    "methodes-variationnelles": "Méthodes variationnelles",
+    "td-assimilation": "TD 6 — Assimilation de données à la main",
+    "tp-assimilation": "TP 6 — L'ETKF sur Lorenz-96",
     # plusieurs cibles (issue 37)
     "fouillis-association": "Fouillis et association",
     "gestion-pistes": "Gérer les pistes",
-    "td-plusieurs-cibles": "TD 7 — Plusieurs cibles à la main",
-    "tp-plusieurs-cibles": "TP 6 — Plusieurs cibles : l'association probabiliste (PDA)",
+    "td-plusieurs-cibles": "TD 8 — Plusieurs cibles à la main",
+    "tp-plusieurs-cibles": "TP 7 — Plusieurs cibles : l'association probabiliste (PDA)",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

@@ -183,7 +183,7 @@ def samu_lab_figure(cv_model=None, nis_gate=None, van_loan=None, imm_mix=None, m
 
 
 @register("tp-pda", chapter="tp-plusieurs-cibles",
-          title="TP 6 : votre PDA et celle du paquet sur l'hélicoptère SAMU 31 dans un fouillis dense")
+          title="TP 7 : votre PDA et celle du paquet sur l'hélicoptère SAMU 31 dans un fouillis dense")
 def pda_lab_figure(pda_weights=None, pda_update=None):
     run = pda_lab(pda_weights, pda_update)
     truth, det, t = run.data["truth"], run.data["detections"], run.data["t"]

@@ -220,11 +220,11 @@ def gospa_figure():
     return fig
 
 
-# --------------------------------------------------------------------------- TD 7
+# --------------------------------------------------------------------------- TD 8
 
 
 @register("td-pda", chapter="td-plusieurs-cibles",
-          title="TD 7 : la correction PDA à la main — un mélange de trois gaussiennes et sa gaussienne résumée")
+          title="TD 8 : la correction PDA à la main — un mélange de trois gaussiennes et sa gaussienne résumée")
 def pda_by_hand_figure():
     c = tutorials.PDA_BY_HAND
     step = tutorials.pda_by_hand()

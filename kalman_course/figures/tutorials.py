@@ -207,7 +207,7 @@ def exam_stationary_figure():
 
 
 @register("td-ekf-invariant", chapter="td-filtrage-invariant",
-          title="TD 6 : l'exponentielle de SE(2) à la main, puis une correction de l'EKF invariant")
+          title="TD 7 : l'exponentielle de SE(2) à la main, puis une correction de l'EKF invariant")
 def se2_by_hand_figure():
     from ..geometry.lie import se2_exp
     from ..scenarios.tutorials import SE2_BY_HAND, se2_by_hand

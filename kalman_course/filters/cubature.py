@@ -63,7 +63,7 @@ def cubature_family(*, redraw: bool = True) -> FilterFamily:
 
 
 def cubature_kalman_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = None, *,
-                           redraw: bool = True) -> FilterResult:
+                           redraw: bool = True, gate: Any = None, fading: Any = None) -> FilterResult:
     r"""Filtre de Kalman à cubature sur toutes les mesures (pour chaque ``y[k]`` : prédiction puis correction,
     dans l'ordre de :func:`~kalman_course.kalman_filter`).
 
@@ -91,10 +91,12 @@ def cubature_kalman_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: A
     redraw : ``True`` (défaut) : nouveaux points à la correction — égal à
         ``unscented_kalman_filter(alpha=1, beta=0, kappa=0)`` et, sur un modèle linéaire, au filtre de
         Kalman ; ``False`` : points propagés réutilisés — égal à ``CubatureKalmanFilter`` de filterpy.
+    gate, fading : porte et mémoire évanescente, options du moteur (:mod:`~kalman_course.filters.gating`),
+        comme pour :func:`~kalman_course.kalman_filter`.
 
     Renvoie un :class:`~kalman_course.FilterResult`.
     """
-    return run_filter(cubature_family(redraw=redraw), model, y, x0, P0, u)
+    return run_filter(cubature_family(redraw=redraw), model, y, x0, P0, u, gate=gate, fading=fading)
 
 
 def cubature_kalman_filter_runs(model: NonlinearModel, Y: Any, x0: Any, P0: Any, u: Any = None, *,

@@ -49,8 +49,9 @@ from typing import Any
 import numpy as np
 
 from ..core.linalg import correct, psd_solve, symmetrize
-from ..core.models import LinearGaussianModel
+from ..core.models import LinearGaussianModel, ModelBatch
 from ..core.results import FilterResult
+from ..core.validation import KalmanInputError
 from .engine import Correction, FilterFamily, gaussian_moments, run_filter
 
 __all__ = ["DIFFUSE_RTOL", "DiffuseFilterResult", "diffuse_family", "diffuse_kalman_filter", "is_determined"]
@@ -71,17 +72,25 @@ def diffuse_family() -> FilterFamily:
     :math:`P_{1\mid 0} = 0` (l'état de la première mesure est :math:`\delta` ; la commande ``u[0]``
     est absorbée dans :math:`\delta`). Les suivantes sont celles du filtre de Kalman, la commande
     :math:`Bu` n'agissant que sur la colonne :math:`a`.
+
+    Mode en lot (:func:`~kalman_course.filters.engine.run_filter_runs`) : ``N`` séries filtrées par le même
+    modèle, ou une même série filtrée par les ``G`` modèles d'un
+    :class:`~kalman_course.core.models.ModelBatch` (un tirage par modèle : matrices (G, …)), sans commande.
     """
 
     def prior(model, x0, P0):
+        if isinstance(model, ModelBatch):
+            raise KalmanInputError("« model » : un lot de modèles (ModelBatch) se filtre par run_filter_runs.")
         return None  # avant la première mesure : aucune information
+
+    def start(n, lead=()):  # [a⁻₁ | X⁻₁] = [0 | I], P₁|₀ = 0
+        xa = np.zeros(lead + (n, n + 1))
+        xa[..., 1:] = np.eye(n)
+        return xa, np.zeros(lead + (n, n))
 
     def predict_step(model: LinearGaussianModel, state, u):
         if state is None:
-            n = model.n_state
-            xa = np.zeros((n, n + 1))
-            xa[:, 1:] = np.eye(n)
-            return xa, np.zeros((n, n))
+            return start(model.n_state)
         xa, P = state
         A = model.A
         xa_pred = A.dot(xa)
@@ -101,15 +110,46 @@ def diffuse_family() -> FilterFamily:
         xa, P, K, S = correct(xa_pred, P_pred, V, C, R)
         return (xa, P), Correction(K, V[:, 0], S)
 
+    def prior_many(model, x0, P0, N, shared=False):
+        return start(model.n_state, (N,))
+
+    def predict_many(model, state, u, k):
+        if k == 0:  # l'état de la première mesure : δ, sans a priori (l'état de départ le pose déjà)
+            return state
+        xa, P = state
+        A = model.A
+        At = np.swapaxes(A, -1, -2)
+        xa_pred = A @ xa
+        if u is not None:
+            xa_pred[..., 0] += u @ np.swapaxes(model.B, -1, -2)
+        return xa_pred, symmetrize(A @ P @ At + model.Q)
+
+    def update_many(model, state, Y, idx, k):
+        xa_pred, P_pred = state
+        C, R = model.C, model.R
+        if idx is not None:
+            C, R = C[..., idx, :], R[..., idx[:, None], idx]
+        V = -(C @ xa_pred)                                           # [v | -E] (N, m_k, 1+n)
+        V[..., 0] += Y
+        PCt = P_pred @ np.swapaxes(C, -1, -2)
+        S = C @ PCt + R
+        K = np.swapaxes(psd_solve(S, np.swapaxes(PCt, -1, -2), where=f"correction par y[{k}]"), -1, -2)
+        xa = xa_pred + K @ V
+        P = symmetrize(P_pred - K @ np.swapaxes(PCt, -1, -2))
+        return (xa, P), Correction(K, V[..., 0], S)
+
     return FilterFamily(
         name="filtre de Kalman à initialisation diffuse",
-        model_type=LinearGaussianModel,
+        model_type=(LinearGaussianModel, ModelBatch),
         model_hint="l'initialisation diffuse exacte n'existe ici que pour un modèle linéaire",
         prior=prior,
         predict=predict_step,
         update=update_step,
         moments=gaussian_moments,  # l'état est déjà ([a | X], P) : le moteur le range tel quel
         state_shape=lambda model: (model.n_state, model.n_state + 1),
+        prior_many=prior_many,
+        predict_many=predict_many,
+        update_many=update_many,
     )
 
 
@@ -177,27 +217,34 @@ def is_determined(J: np.ndarray) -> np.ndarray:
 def masked_innovations(innovation: np.ndarray, S: np.ndarray, observed: np.ndarray):
     r"""Innovations et covariances « complétées » pour un calcul en bloc : composantes manquantes mises à 0,
     bloc manquant de :math:`S` remplacé par l'identité (les termes quadratiques et le
-    :math:`\log|S|` se réduisent ainsi aux composantes observées). ``innovation`` (T, m),
-    ``S`` (T, m, m), ``observed`` (T, m) ; renvoie ``(v (T, m), S (T, m, m))``."""
+    :math:`\log|S|` se réduisent ainsi aux composantes observées). ``innovation`` (…, T, m),
+    ``S`` (…, T, m, m), ``observed`` (…, T, m) ; renvoie ``(v (…, T, m), S (…, T, m, m))``."""
     obs = np.asarray(observed, dtype=bool)
     v = np.where(obs, innovation, 0.0)
-    both = obs[:, :, None] & obs[:, None, :]
-    eye = np.broadcast_to(np.eye(obs.shape[1], dtype=bool), both.shape)
+    both = obs[..., :, None] & obs[..., None, :]
+    eye = np.broadcast_to(np.eye(obs.shape[-1], dtype=bool), both.shape)
     S_full = np.where(both, S, np.where(eye, 1.0, 0.0))
     return v, S_full
 
 
-def diffuse_information(model: LinearGaussianModel, augmented: FilterResult):
-    r""":math:`J_k` (T, n, n) et :math:`h_k` (T, n) cumulés, à partir du filtre augmenté (voir le module)."""
-    n = model.n_state
+def diffuse_information(model: LinearGaussianModel | ModelBatch, augmented: FilterResult):
+    r""":math:`J_k` (T, n, n) et :math:`h_k` (T, n) cumulés, à partir du filtre augmenté (voir le module) ;
+    pour un lot (``augmented`` d'axe des tirages en tête, ``model`` un
+    :class:`~kalman_course.core.models.ModelBatch` ou un modèle commun), (N, T, n, n) et (N, T, n)."""
     obs = np.asarray(augmented.observed, dtype=bool)
-    C = model.sequence("C", obs.shape[0])  # (T, m, n) : C_k (constante ou variable dans le temps)
-    E = np.where(obs[:, :, None], C @ augmented.x_pred[:, :, 1:], 0.0)  # (T, m, n)
+    T = obs.shape[-2]
+    n = augmented.x_pred.shape[-2]
+    if isinstance(model, ModelBatch):
+        C = model.C[:, None]                                 # (G, 1, m, n) : C_g à tous les pas
+    else:
+        C = np.asarray(model.sequence("C", T))              # (T, m, n) : C_k (constante ou variable)
+    E = np.where(obs[..., :, :, None], C @ augmented.x_pred[..., 1:], 0.0)  # (…, T, m, n)
     v, S = masked_innovations(augmented.innovation, augmented.S, obs)
-    SiE = psd_solve(S, E)  # S⁻¹E par Cholesky (jamais d'inverse explicite)
-    J = np.cumsum(np.swapaxes(E, 1, 2) @ SiE, axis=0)
-    h = np.cumsum(np.einsum("tmn,tm->tn", SiE, v), axis=0)
-    return symmetrize(J).reshape(-1, n, n), h
+    lead = S.shape[:-2]
+    SiE = psd_solve(S.reshape((-1,) + S.shape[-2:]), E.reshape((-1,) + E.shape[-2:])).reshape(E.shape)
+    J = np.cumsum(np.swapaxes(E, -1, -2) @ SiE, axis=-3)
+    h = np.cumsum((np.swapaxes(SiE, -1, -2) @ v[..., None])[..., 0], axis=-2)
+    return symmetrize(J).reshape(lead + (n, n)), h
 
 
 def _collapse(xa: np.ndarray, P: np.ndarray, J: np.ndarray, h: np.ndarray, ok: np.ndarray):

@@ -27,6 +27,17 @@ d'une racine. L'état interne porte alors, en ``state[1]``, une racine :math:`M`
 et forme toutes les covariances du résultat à la fin, en un produit en lot, au lieu d'un produit
 :math:`M^TM` par pas qui ne servirait qu'au résultat.
 
+**Options du moteur** (:mod:`~kalman_course.filters.gating`) : la porte (``gate=p``), la mémoire évanescente
+(``fading=α``) et l'adaptation de :math:`Q` (``adapt=Adaptation(...)``) sont appliquées ici, une fois pour
+toutes les familles, à partir de ce que rendent leurs étapes : l'innovation et :math:`S` de la
+:class:`Correction` (ou la racine de :math:`S` d'une famille en racine carrée), l'état prédit. Une famille les
+déclare par trois crochets : ``inflate(state, α)`` → état dont la covariance est multipliée par
+:math:`\alpha^2` (mémoire évanescente) ; ``gating=True`` (la :class:`Correction` porte l'innovation et
+:math:`S` de la mesure prédite : la porte s'applique ; ``gate_nis(state, corr)`` donne, s'il le faut, les NIS
+de plusieurs hypothèses, une par régime d'un IMM, et la mesure est gardée si l'une passe) ;
+``noise_image(model, predicted, idx)`` → :math:`G = HQH^T` (adaptation). Une option demandée à une famille
+qui ne la déclare pas est refusée en français.
+
 Le moteur (:func:`run_filter`) fait, une fois pour toutes les familles, ce que faisait chaque boucle :
 vérifier le modèle, ``y``, ``u``, l'a priori ; traiter les mesures manquantes (ligne ``None``/``NaN`` :
 prédiction seule ; ligne partielle : correction avec les seules composantes observées) ; assembler le
@@ -51,8 +62,8 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
-from ..core.models import model_steps
-from ..core.results import FilterHistory, FilterResult, FilterRuns
+from ..core.models import model_steps, scale_process_noise
+from ..core.results import AdaptiveResult, FilterHistory, FilterResult, FilterRuns
 from ..core.simulation import as_generator
 from ..core.validation import (
     KalmanInputError,
@@ -69,6 +80,7 @@ from ..core.validation import (
     check_psd,
     shape_text,
 )
+from .gating import Adaptation, fading_factor, gate_probability, gate_threshold, nis_value, root_nis
 
 __all__ = [
     "Correction",
@@ -121,6 +133,10 @@ class FilterFamily:
     (g, m_k) ne contiennent que les ``g`` tirages qui observent les composantes ``idx`` (``None`` :
     toutes) et où les champs de la :class:`Correction` ont un axe des tirages en tête (``n_iter`` (g,)).
 
+    Options du moteur (voir l'en-tête du module) : ``inflate(state, alpha)`` (mémoire évanescente),
+    ``gating`` et ``gate_nis(state, corr)`` (porte), ``noise_image(model, predicted, idx)`` (adaptation de
+    :math:`Q`, :math:`G = HQH^T` sur les composantes observées ``idx``).
+
     ``batch_controls`` : ``predict_many`` accepte des commandes propres à chaque tirage, ``u_k`` (N, p)
     (sinon le moteur prédit ces tirages un par un). ``shared_covariance`` : la récurrence des
     covariances ne dépend pas des mesures (filtre de Kalman linéaire) ; sans mesure manquante et avec un
@@ -147,6 +163,10 @@ class FilterFamily:
     update_many: Callable[[Any, Any, np.ndarray, np.ndarray | None, int], tuple[Any, Correction]] | None = None
     batch_controls: bool = False
     shared_covariance: bool = False
+    inflate: Callable[[Any, float], Any] | None = None
+    gating: bool = False
+    gate_nis: Callable[[Any, Correction], Any] | None = None
+    noise_image: Callable[[Any, Any, np.ndarray | None], np.ndarray] | None = None
 
 
 def gaussian_prior(model: Any, x0: Any, P0: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -189,7 +209,8 @@ def observed_rows(Y: np.ndarray) -> np.ndarray:
 
 
 def run_filter(
-    family: FilterFamily, model: Any, y: Any, x0: Any, P0: Any, u: Any = None, *, rng: Any = None
+    family: FilterFamily, model: Any, y: Any, x0: Any, P0: Any, u: Any = None, *, rng: Any = None,
+    gate: Any = None, fading: Any = None, adapt: Adaptation | None = None,
 ) -> FilterResult:
     r"""Applique la famille ``family`` à toutes les mesures : pour chaque ``y[k]``, prédiction avec
     ``u[k]`` puis correction.
@@ -209,6 +230,14 @@ def run_filter(
     u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]`` sert à prédire vers ``y[k]``).
     rng : graine entière ou ``numpy.random.Generator`` — obligatoire pour une famille ``stochastic``,
         refusé pour les autres.
+    gate : probabilité :math:`0 < p < 1`, optionnelle — porte (:mod:`~kalman_course.filters.gating`) : une
+        mesure dont la NIS dépasse :math:`\chi^2_{m_k}(p)` est rejetée (prédiction seule,
+        ``result.rejected``), son innovation et sa covariance gardées.
+    fading : facteur :math:`\alpha \ge 1`, optionnel — mémoire évanescente (covariance a posteriori
+        multipliée par :math:`\alpha^2` avant la prédiction).
+    adapt : :class:`~kalman_course.filters.gating.Adaptation`, optionnelle — :math:`Q` remise à l'échelle
+        par ajustement de covariance ; le résultat est alors un
+        :class:`~kalman_course.core.results.AdaptiveResult` (``q_scale`` (T,)).
 
     Renvoie un ``family.result_type`` : ``x`` (T, …), ``P`` (T, d, d), ``x_pred``, ``P_pred``,
     ``K`` (T, d, m), ``innovation`` (T, m), ``S`` (T, m, m), ``observed`` (T, m), ``n_iter`` (T,), et
@@ -221,6 +250,9 @@ def run_filter(
         raise KalmanInputError(f"« rng » est fourni, mais le {family.name} ne tire rien au hasard : retirez-le.")
     else:
         draws = {}
+    p_gate = gate_probability(gate, "gate")
+    alpha = fading_factor(fading)
+    _check_options(family, p_gate, fading, alpha, adapt)
     m = model.n_obs
     Y = as_measurements("y", y, m)
     T = Y.shape[0]
@@ -242,15 +274,27 @@ def run_filter(
     xs, Ps, xps, Pps = out.x, out.P, out.x_pred, out.P_pred
     Ks, nus, Ss, n_iter = out.K, out.innovation, out.S, out.n_iter
     steps = model_steps(model, T)  # modèle variable dans le temps : celui du pas k (model.at(k))
+    inflate = family.inflate if alpha is not None else None
+    options = p_gate is not None or adapt is not None
+    run = adapt.start() if adapt is not None else None
+    scales = np.empty(T) if run is not None else None
     for k in range(T):
         mk = model if steps is None else steps[k]
-        predicted = predict(mk, state, None if U is None else U[k])
-        if full[k]:
+        if inflate is not None:
+            state = inflate(state, alpha)
+        predicted = predict(mk if run is None else scale_process_noise(mk, run.scale), state,
+                            None if U is None else U[k])
+        if full[k] and not options:
             state, corr = update(mk, predicted, Y[k], None)
             Ks[k], nus[k], Ss[k], n_iter[k] = corr
         elif some[k]:
-            idx = np.flatnonzero(observed[k])
-            state, corr = update(mk, predicted, Y[k, idx], idx)
+            idx = None if full[k] else np.flatnonzero(observed[k])
+            state, corr = update(mk, predicted, Y[k] if idx is None else Y[k, idx], idx)
+            if p_gate is not None and _outside_gate(family, state, corr, p_gate, roots):
+                state, corr = predicted, Correction(np.zeros_like(corr.K), corr.innovation, corr.S, 0)
+            elif run is not None:
+                S = corr.S.T.dot(corr.S) if roots else corr.S
+                run.observe(corr.innovation, S, family.noise_image(mk, predicted, idx))
             out.correction(k, corr, idx)
         else:
             state = predicted
@@ -267,7 +311,50 @@ def run_filter(
         if step_outputs is not None:
             for name, value in step_outputs(state).items():
                 extras.setdefault(name, []).append(value)
-    return out.result(family.result_type, **{name: np.stack(values) for name, values in extras.items()})
+        if scales is not None:
+            scales[k] = run.scale
+    stacked = {name: np.stack(values) for name, values in extras.items()}
+    if scales is not None:
+        return out.result(AdaptiveResult, q_scale=scales, **stacked)
+    return out.result(family.result_type, **stacked)
+
+
+def _check_options(family: FilterFamily, p_gate: float | None, fading: Any, alpha: float | None,
+                   adapt: Any) -> None:
+    """Une option du moteur demandée à une famille qui ne la déclare pas : une erreur française."""
+    if p_gate is not None and not family.gating:
+        raise KalmanInputError(
+            f"« gate » : le {family.name} n'a pas de porte (sa correction ne rend pas l'innovation et la covariance "
+            "S de la mesure prédite) ; retirez « gate » ou prenez un filtre gaussien (kalman_filter, "
+            "extended_kalman_filter, unscented_kalman_filter, cubature_kalman_filter, gauss_hermite_kalman_filter, "
+            "imm_filter)."
+        )
+    if alpha is not None and family.inflate is None:
+        raise KalmanInputError(
+            f"« fading » : le {family.name} n'a pas de mémoire évanescente ; retirez « fading » ou prenez un filtre "
+            "gaussien (kalman_filter, extended_kalman_filter, unscented_kalman_filter, cubature_kalman_filter, "
+            "gauss_hermite_kalman_filter, imm_filter)."
+        )
+    if adapt is not None:
+        if not isinstance(adapt, Adaptation):
+            raise KalmanInputError(
+                f"« adapt » doit être un réglage Adaptation(window=…, min_scale=…, detect=…) ; reçu {type(adapt).__name__}."
+            )
+        if family.noise_image is None or family.result_type is not FilterResult:
+            raise KalmanInputError(
+                f"« adapt » : le {family.name} n'a pas d'adaptation de Q ; prenez adaptive_kalman_filter (modèle "
+                "linéaire) ou un filtre gaussien d'un seul modèle."
+            )
+
+
+def _outside_gate(family: FilterFamily, state: Any, corr: Correction, p_gate: float, roots: bool) -> bool:
+    r"""Vrai si la mesure est hors de la porte :math:`\chi^2_{m_k}(p)` : sa NIS (celle de chaque hypothèse
+    si la famille en a plusieurs, ``gate_nis`` ; la mesure est gardée si l'une passe) dépasse le seuil."""
+    threshold = gate_threshold(p_gate, len(corr.innovation))
+    if family.gate_nis is not None:
+        return bool(np.min(family.gate_nis(state, corr)) > threshold)
+    nis = root_nis(corr.innovation, corr.S) if roots else nis_value(corr.innovation, corr.S)
+    return nis > threshold
 
 
 def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, u: Any = None) -> FilterRuns:
@@ -315,10 +402,9 @@ def run_filter_runs(family: FilterFamily, model: Any, Y: Any, x0: Any, P0: Any, 
     shared = family.shared_covariance and bool(full.all()) and np.ndim(P0) < 3
     state = family.prior_many(model, x0, P0, N, shared=True) if shared else family.prior_many(model, x0, P0, N)
     moments = family.moments
-    X_first, P_first = moments(state)
-    x_shape, n = X_first.shape[1:], P_first.shape[-1]  # estimation (n,) ou pose (4, 4)… ; covariance (n, n)
+    shape, n = family.state_shape(model), family.tangent_dim(model)  # estimation (n,) ou matrice (filtre augmenté)
     lead = () if shared else (N,)  # axe des tirages des covariances, gains et S
-    xs, xps = np.empty((N, T) + x_shape), np.empty((N, T) + x_shape)
+    xs, xps = np.empty((N, T) + shape), np.empty((N, T) + shape)
     Ps, Pps = np.empty(lead + (T, n, n)), np.empty(lead + (T, n, n))
     Ks = np.zeros(lead + (T, n, m))  # gain nul pour une composante manquante : aucune correction
     nus = np.full((N, T, m), np.nan)

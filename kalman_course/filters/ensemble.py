@@ -21,6 +21,11 @@ Sans les perturbations :math:`v^i`, la dispersion de l'ensemble analysé serait
 :math:`(I - KH)P(I - KH)^T` au lieu de :math:`(I - KH)P` : trop petite. Sur un modèle linéaire gaussien,
 la moyenne et la covariance de l'ensemble tendent vers celles du filtre de Kalman quand :math:`N \to \infty`
 (erreur en :math:`1/\sqrt N`).
+
+Les analyses déterministes de l'assimilation de données — ETKF, LETKF, DEnKF — et le taper de
+Gaspari–Cohn sont dans :mod:`.ensemble_analysis` ; la même famille les enchaîne dans le temps
+(``method=``), suivies de l'**inflation** des anomalies analysées,
+:math:`x^i \leftarrow \bar x + \lambda(x^i - \bar x)`.
 """
 
 from __future__ import annotations
@@ -37,9 +42,19 @@ from ..core.results import FilterResult
 from ..core.simulation import check_positive_int
 from ..core.validation import KalmanInputError, as_gaussian
 from .engine import Correction, FilterFamily, run_filter
+from .ensemble_analysis import (
+    as_distances,
+    check_inflation,
+    check_radius,
+    denkf_analysis,
+    etkf_analysis,
+    gaspari_cohn,
+    letkf_analysis,
+    symmetric_inverse_root,
+)
 from .extended import NONLINEAR_HINT
 
-__all__ = ["EnsembleFilterResult", "ensemble_family", "ensemble_kalman_filter"]
+__all__ = ["METHODS", "EnsembleFilterResult", "ensemble_family", "ensemble_kalman_filter"]
 
 @dataclass(frozen=True, eq=False, repr=False)
 class EnsembleFilterResult(FilterResult):
@@ -54,13 +69,17 @@ class EnsembleState(NamedTuple):
     r"""État interne : ``X`` (N, n) les membres ; ``k`` l'indice de la mesure visée (messages d'erreur) ;
     ``LQ`` (n, n), ``LR`` (m, m) : facteurs :math:`L_QL_Q^T = Q`, :math:`L_RL_R^T = R` (calculés une fois,
     le modèle ne change pas) ; ``moments`` : :math:`(\bar x, P, X - \bar x)` de l'ensemble, calculés une
-    seule fois (le moteur les range, l'analyse réutilise la moyenne et les écarts de l'ensemble prévu)."""
+    seule fois (le moteur les range, l'analyse réutilise la moyenne et les écarts de l'ensemble prévu) ;
+    ``W`` (m, m) : :math:`R^{-1/2}` des analyses déterministes ; ``rho`` (m, n) : poids de Gaspari–Cohn du
+    LETKF."""
 
     X: np.ndarray
     k: int
     LQ: np.ndarray | None = None
     LR: np.ndarray | None = None
     moments: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    W: np.ndarray | None = None
+    rho: np.ndarray | None = None
 
 
 def _moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -71,12 +90,53 @@ def _moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x, symmetrize(D.T.dot(D) / (X.shape[0] - 1)), D
 
 
-def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = True) -> FilterFamily:
-    r"""Les étapes de l'EnKF stochastique pour le moteur (famille ``stochastic``) ; ``perturb=False``
-    retire les perturbations :math:`v^i` des observations (pour montrer pourquoi elles sont nécessaires)."""
+#: Les analyses de ``ensemble_kalman_filter(method=...)``.
+METHODS = ("stochastic", "etkf", "denkf")
+
+
+def _check_method(method: Any) -> str:
+    if not isinstance(method, str) or method not in METHODS:
+        raise KalmanInputError(
+            f"« method » doit valoir {', '.join(repr(m) for m in METHODS)} (EnKF stochastique, ETKF, DEnKF) ; "
+            f"reçu {method!r}."
+        )
+    return method
+
+
+def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = True, method: str = "stochastic",
+                    inflation: float = 1.0, localization: Any = None, distances: Any = None) -> FilterFamily:
+    r"""Les étapes des filtres d'ensemble pour le moteur : l'analyse ``method`` (``"stochastic"`` :
+    observations perturbées ; ``"etkf"`` : transformée symétrique, ou LETKF avec ``localization`` ;
+    ``"denkf"`` : EnKF déterministe), puis les anomalies analysées multipliées par ``inflation``.
+    ``perturb=False`` retire les perturbations :math:`v^i` des observations de l'EnKF stochastique (pour
+    montrer pourquoi elles sont nécessaires)."""
     N = check_positive_int("n_members", n_members, minimum=2)
     if not isinstance(perturb, (bool, np.bool_)):
         raise KalmanInputError(f"« perturb » doit être un booléen ; reçu {perturb!r}.")
+    method = _check_method(method)
+    if not perturb and method != "stochastic":
+        raise KalmanInputError(
+            f"« perturb=False » ne s'applique qu'à l'EnKF stochastique (method='stochastic') : l'analyse "
+            f"{method!r} ne perturbe pas les observations."
+        )
+    lam = check_inflation(inflation)
+    radius = None
+    if localization is not None:
+        radius = check_radius("localization", localization)
+        if method != "etkf":
+            raise KalmanInputError(
+                f"« localization » s'applique à method='etkf' (le LETKF) ; reçu method={method!r}."
+            )
+        if distances is None:
+            raise KalmanInputError(
+                "« localization » exige « distances » (m, n) : la distance de chaque observation à chaque "
+                "composante de l'état."
+            )
+    elif distances is not None:
+        raise KalmanInputError(
+            "« distances » est fourni sans « localization » : donnez le rayon de localisation (localization=…), "
+            "ou retirez distances."
+        )
 
     def prior(model, x0, P0, rng):
         if model.f_noise_jacobian is not None or model.h_noise_jacobian is not None:
@@ -85,21 +145,27 @@ def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = 
                 "h_noise_jacobian."
             )
         x, P = as_gaussian(x0, P0, model.n_state, "x0", "P0")
+        rho = None
+        if radius is not None:
+            rho = gaspari_cohn(as_distances("distances", distances, model.n_obs, model.n_state), radius)
         X = x + rng.standard_normal((N, model.n_state)).dot(covariance_factor(P).T)
-        return EnsembleState(X, -1, covariance_factor(model.Q), np.linalg.cholesky(model.R))
+        W = None if method == "stochastic" else symmetric_inverse_root(model.R)
+        return EnsembleState(X, -1, covariance_factor(model.Q), np.linalg.cholesky(model.R), None, W, rho)
 
     def predict_step(model, state, u, rng):
         X = model.transition_many(state.X, u)
         X = X + rng.standard_normal(X.shape).dot(state.LQ.T)
-        return EnsembleState(X, state.k + 1, state.LQ, state.LR, _moments(X))
+        return state._replace(X=X, k=state.k + 1, moments=_moments(X))
 
     def update_step(model, state, y, idx, rng):
         X = state.X
         HX = model.observe_many(X)
-        R, LR = model.R, state.LR
+        R, LR, W, rho = model.R, state.LR, state.W, state.rho
         if idx is not None:
             HX, R = HX[:, idx], R[np.ix_(idx, idx)]
             LR = np.linalg.cholesky(R)
+            W = None if W is None else symmetric_inverse_root(R)
+            rho = None if rho is None else rho[idx]
         angles = model.observed_angles(idx)
         x_bar, _, dX = state.moments or _moments(X)  # moyenne et écarts de l'ensemble prévu
         y_bar = HX.mean(axis=0)
@@ -112,20 +178,33 @@ def ensemble_family(n_members: int, keep_members: bool = False, perturb: bool = 
         S = dY.T.dot(dY) / (N - 1) + R
         K = psd_solve(S, Pxy.T, message=f"EnKF, analyse par y[{state.k}] : la covariance d'innovation P_yy + R "
                                          "n'est pas définie positive.").T
-        D = y - HX
-        if perturb:
-            D = D + rng.standard_normal((N, R.shape[0])).dot(LR.T)
-        if angles:
-            D[:, angles] = wrap_angle(D[:, angles])
-        X_new = X + D.dot(K.T)
         nu = model.residual(y, y_bar, idx)
-        return EnsembleState(X_new, state.k, state.LQ, state.LR, _moments(X_new)), Correction(K, nu, S)
+        if method == "stochastic":
+            D = y - HX
+            if perturb:
+                D = D + rng.standard_normal((N, R.shape[0])).dot(LR.T)
+            if angles:
+                D[:, angles] = wrap_angle(D[:, angles])
+            X_new = X + D.dot(K.T)
+            if lam != 1.0:
+                x_a = X_new.mean(axis=0)
+                X_new = x_a + lam * (X_new - x_a)
+        elif method == "denkf":
+            X_new = denkf_analysis(x_bar, dX, dY, nu, R, lam, K=K)
+        elif rho is None:
+            X_new = etkf_analysis(x_bar, dX, dY, nu, R, lam, W=W)
+        else:
+            X_new = letkf_analysis(x_bar, dX, dY, nu, R, rho, lam, W=W)
+        return state._replace(X=X_new, moments=_moments(X_new)), Correction(K, nu, S)
 
     def outputs(state):
         return {"members": state.X} if keep_members else {}
 
+    names = {"stochastic": "filtre de Kalman d'ensemble (EnKF)", "denkf": "EnKF déterministe (DEnKF)",
+             "etkf": "filtre de Kalman d'ensemble à transformée (ETKF)" if radius is None
+             else "ETKF local (LETKF)"}
     return FilterFamily(
-        name="filtre de Kalman d'ensemble (EnKF)",
+        name=names[method],
         model_type=NonlinearModel,
         model_hint=NONLINEAR_HINT,
         prior=prior,
@@ -149,8 +228,17 @@ def ensemble_kalman_filter(
     rng: Any,
     keep_members: bool = False,
     perturb: bool = True,
+    method: str = "stochastic",
+    inflation: float = 1.0,
+    localization: Any = None,
+    distances: Any = None,
 ) -> EnsembleFilterResult:
-    r"""Filtre de Kalman d'ensemble stochastique (observations perturbées) sur toutes les mesures.
+    r"""Filtre de Kalman d'ensemble sur toutes les mesures : stochastique (observations perturbées, par
+    défaut), à transformée (ETKF, ou LETKF avec ``localization``) ou déterministe (DEnKF).
+
+    Les membres partent i.i.d. de :math:`\mathcal N(x_0, P_0)` ; à chaque cycle, chaque membre est prévu par
+    :math:`f` plus un bruit :math:`\mathcal N(0, Q)`, l'ensemble est analysé avec ``y[k]`` (l'analyse de
+    ``method``), puis ses anomalies analysées sont multipliées par ``inflation``.
 
     Paramètres
     ----------
@@ -160,13 +248,26 @@ def ensemble_kalman_filter(
     x0 : (n,), P0 : (n, n) — loi de l'ensemble initial.
     u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]``, qui contient :math:`u_{k-1}`, sert à prédire vers ``y[k]``).
     n_members : taille :math:`N \ge 2` de l'ensemble.
-    rng : graine entière ou ``numpy.random.Generator`` (obligatoire).
+    rng : graine entière ou ``numpy.random.Generator`` (obligatoire) ; tous les tirages en viennent.
     keep_members : garder l'ensemble analysé de chaque pas (``members`` (T, N, n)).
     perturb : perturber les observations (défaut, l'EnKF stochastique) ; ``False`` : même gain sans
         perturbations — l'ensemble analysé est alors trop resserré, :math:`(I-KH)P(I-KH)^T` au lieu de
-        :math:`(I-KH)P` (démonstration du chapitre).
+        :math:`(I-KH)P` (démonstration du chapitre). Pour ``method="stochastic"`` seulement.
+    method : ``"stochastic"`` (observations perturbées), ``"etkf"``
+        (:func:`~kalman_course.filters.ensemble_analysis.etkf_update`) ou ``"denkf"``
+        (:func:`~kalman_course.filters.ensemble_analysis.denkf_update`).
+    inflation : :math:`\lambda \ge 1`, facteur des anomalies analysées (1 : aucune inflation).
+    localization : rayon de localisation :math:`> 0` (``numpy.inf`` permis) : ``"etkf"`` devient le LETKF
+        (:func:`~kalman_course.filters.ensemble_analysis.letkf_update`) ; ``numpy.inf`` redonne, avec le même
+        ``rng``, le résultat de ``localization=None`` (au bit près : tous les poids valent 1, les analyses
+        locales sont l'analyse globale).
+    distances : (m, n), exigé avec ``localization`` — distance de l'observation :math:`i` à la composante
+        :math:`j` de l'état.
 
-    Renvoie un :class:`EnsembleFilterResult` : ``x`` (T, n) moyenne, ``P`` (T, n, n) covariance
-    d'échantillon, ``K`` (T, n, m) gain de l'analyse, ``innovation`` :math:`y - \bar y`, ``S`` :math:`P_{yy} + R`.
+    Renvoie un :class:`EnsembleFilterResult` : ``x`` (T, n) moyenne et ``P`` (T, n, n) covariance
+    d'échantillon de l'ensemble analysé, ``x_pred``, ``P_pred`` celles de l'ensemble prévu, ``K`` (T, n, m)
+    gain :math:`P_{xy}(P_{yy} + R)^{-1}` de l'ensemble prévu, ``innovation`` :math:`y - \bar y`,
+    ``S`` :math:`P_{yy} + R`, ``members`` (T, N, n) si ``keep_members``.
     """
-    return run_filter(ensemble_family(n_members, keep_members, perturb), model, y, x0, P0, u, rng=rng)
+    family = ensemble_family(n_members, keep_members, perturb, method, inflation, localization, distances)
+    return run_filter(family, model, y, x0, P0, u, rng=rng)

@@ -271,7 +271,8 @@ def ekf_update(model: NonlinearModel, x_pred: Any, P_pred: Any, y: Any, *, josep
 
 
 def extended_kalman_filter(
-    model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = None, *, joseph: bool = False
+    model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = None, *, joseph: bool = False, gate: Any = None,
+    fading: Any = None,
 ) -> FilterResult:
     r"""Filtre de Kalman étendu sur toutes les mesures (pour chaque ``y[k]`` : :func:`ekf_predict` puis
     :func:`ekf_update`), dans l'ordre de :func:`~kalman_course.kalman_filter`.
@@ -283,11 +284,14 @@ def extended_kalman_filter(
     x0 : (n,) — :math:`\hat x_0` ; P0 : (n, n) — :math:`P_0`.
     u : (T, p), ou (T,) si p = 1, optionnel — commandes (``u[k]`` sert à prédire vers ``y[k]``).
     joseph : forme de Joseph pour la covariance a posteriori.
+    gate, fading : porte et mémoire évanescente, options du moteur (:mod:`~kalman_course.filters.gating`),
+        comme pour :func:`~kalman_course.kalman_filter` (la NIS de la porte est celle de l'innovation
+        :math:`y_k - h(\hat x^-_k)` sous :math:`S_k = H_kP^-_kH_k^T + VRV^T`).
 
-    Renvoie un :class:`~kalman_course.FilterResult` (``n_iter`` vaut 1 à chaque pas observé, 0 sinon).
+    Renvoie un :class:`~kalman_course.FilterResult` (``n_iter`` vaut 1 à chaque pas observé, 0 sinon, et aux
+    pas rejetés par la porte).
     """
-
-    return run_filter(extended_family(joseph), model, y, x0, P0, u)
+    return run_filter(extended_family(joseph), model, y, x0, P0, u, gate=gate, fading=fading)
 
 
 def extended_kalman_filter_runs(

@@ -103,7 +103,8 @@ def gauss_hermite_family(*, order: int = 3, redraw: bool = True) -> FilterFamily
 
 
 def gauss_hermite_kalman_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = None, *,
-                                order: int = 3, redraw: bool = True) -> FilterResult:
+                                order: int = 3, redraw: bool = True, gate: Any = None,
+                                fading: Any = None) -> FilterResult:
     r"""Filtre de Kalman de Gauss–Hermite sur toutes les mesures (pour chaque ``y[k]`` : prédiction puis
     correction, dans l'ordre de :func:`~kalman_course.kalman_filter`) : les formules du filtre gaussien, les
     moments calculés sur les :math:`p^n` points de Gauss–Hermite.
@@ -119,10 +120,13 @@ def gauss_hermite_kalman_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any,
         :math:`2p - 1 \ge d`, sa covariance (degré :math:`2d`) dès :math:`2p - 1 \ge 2d` — pour
         :math:`h(x) = x^3`, dès :math:`p = 4`. Au plus :data:`MAX_POINTS` points :math:`p^n`.
     redraw : nouveaux points à la correction (défaut) ou points propagés réutilisés.
+    gate, fading : porte et mémoire évanescente, options du moteur (:mod:`~kalman_course.filters.gating`),
+        comme pour :func:`~kalman_course.kalman_filter`.
 
     Renvoie un :class:`~kalman_course.FilterResult`.
     """
-    return run_filter(gauss_hermite_family(order=order, redraw=redraw), model, y, x0, P0, u)
+    return run_filter(gauss_hermite_family(order=order, redraw=redraw), model, y, x0, P0, u, gate=gate,
+                      fading=fading)
 
 
 def gauss_hermite_kalman_filter_runs(model: NonlinearModel, Y: Any, x0: Any, P0: Any, u: Any = None, *,

@@ -527,6 +527,16 @@ def gaussian_family(rule: GaussianRule, *, joseph: bool = False, redraw: bool = 
                                                points)
         return (X, P), Correction(K, nu, S)
 
+    def inflate(state, alpha):  # mémoire évanescente : P ← α² P avant la prédiction
+        return (state[0], alpha * alpha * state[1]) + tuple(state[2:])
+
+    def noise_image(model, predicted, idx):  # G = H Q Hᵀ, H linéarisée en x̂⁻ (adaptation de Q)
+        x_pred = predicted[0]
+        H = model.observation_jacobian(x_pred)
+        if idx is not None:
+            H = H[idx]
+        return H.dot(model.process_noise(x_pred)).dot(H.T)
+
     return FilterFamily(
         name=name or rule.filter_name,
         model_type=NonlinearModel,
@@ -538,6 +548,9 @@ def gaussian_family(rule: GaussianRule, *, joseph: bool = False, redraw: bool = 
         prior_many=prior_many,
         predict_many=predict_many,
         update_many=update_many,
+        inflate=inflate,
+        gating=True,
+        noise_image=noise_image,
     )
 
 
@@ -558,7 +571,7 @@ def _check_rule(rule: Any) -> GaussianRule:
 
 
 def gaussian_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = None, *, rule: GaussianRule,
-                    redraw: bool = True, joseph: bool = False) -> FilterResult:
+                    redraw: bool = True, joseph: bool = False, gate: Any = None, fading: Any = None) -> FilterResult:
     r"""Le filtre gaussien de règle ``rule`` sur toutes les mesures (pour chaque ``y[k]`` : prédiction puis
     correction, dans l'ordre de :func:`~kalman_course.kalman_filter`).
 
@@ -577,10 +590,15 @@ def gaussian_filter(model: NonlinearModel, y: Any, x0: Any, P0: Any, u: Any = No
     redraw : ``True`` : la correction tire de nouveaux points de :math:`(\hat x^-, P^-)` ; ``False`` :
         elle réutilise les points propagés par :math:`f` (sans effet pour la linéarisation).
     joseph : forme de Joseph (écrite avec la covariance croisée) pour :math:`P`.
+    gate, fading : options du moteur (:mod:`~kalman_course.filters.gating`), comme pour
+        :func:`~kalman_course.kalman_filter` : porte :math:`\chi^2_{m_k}(p)` sur la NIS
+        :math:`\nu_k^TS_k^{-1}\nu_k` (``result.rejected``), mémoire évanescente :math:`P \leftarrow \alpha^2P`
+        avant chaque prédiction.
 
     Renvoie un :class:`~kalman_course.FilterResult`.
     """
-    return run_filter(gaussian_family(_check_rule(rule), joseph=joseph, redraw=redraw), model, y, x0, P0, u)
+    return run_filter(gaussian_family(_check_rule(rule), joseph=joseph, redraw=redraw), model, y, x0, P0, u,
+                      gate=gate, fading=fading)
 
 
 def gaussian_filter_runs(model: NonlinearModel, Y: Any, x0: Any, P0: Any, u: Any = None, *, rule: GaussianRule,

@@ -57,7 +57,6 @@ from ..core.validation import (
 )
 from ..geometry.lie import ROTATION_TOL, _se2_exp, _se2_exp_many, as_se2_pose
 from .engine import Correction, FilterFamily, gaussian_moments, run_filter, run_filter_runs
-from .gating import fading_factor, gate_probability, gate_threshold, nis_value
 
 __all__ = [
     "OdometryGnssModel",
@@ -264,13 +263,11 @@ def _add_noise(Pp, c, s, q1, q2, q3):
     return Pp
 
 
-def _invariant_predict(model, T, P, u, alpha2=None):
+def _invariant_predict(model, T, P, u):
     c, s, tx, ty = _step_increment(u, model.dt)
     q1, q2, q3 = model._step_noise
     F = np.array(((c, s, s * tx - c * ty), (-s, c, c * tx + s * ty), (0.0, 0.0, 1.0)))  # Ad(U⁻¹)
     Pp = F.dot(P).dot(F.T)
-    if alpha2 is not None:
-        Pp *= alpha2
     # G Q Gᵀ = dt² diag(Rᵀ diag(q₁, q₂) R, q₃), R = Exp(ω dt) : Rᵀ = [[c, s], [−s, c]]
     _add_noise(Pp, c, -s, q1, q2, q3)
     # T̂ U : (R̂ Exp(ω dt), p̂ + R̂ v dt)
@@ -280,14 +277,12 @@ def _invariant_predict(model, T, P, u, alpha2=None):
     return T_new, Pp
 
 
-def _standard_predict(model, T, P, u, alpha2=None):
+def _standard_predict(model, T, P, u):
     c, s, tx, ty = _step_increment(u, model.dt)
     q1, q2, q3 = model._step_noise
     (a, b, x), (d, e, y_) = T[:2].tolist()  # R̂ = [[a, b], [d, e]] avant la prédiction
     F = np.array(((1.0, 0.0, b * tx - a * ty), (0.0, 1.0, e * tx - d * ty), (0.0, 0.0, 1.0)))  # R̂ J v dt
     Pp = F.dot(P).dot(F.T)
-    if alpha2 is not None:
-        Pp *= alpha2
     _add_noise(Pp, a, d, q1, q2, q3)  # G Q Gᵀ = dt² diag(R̂ diag(q₁, q₂) R̂ᵀ, q₃)
     T_new = np.array(((a * c + b * s, b * c - a * s, x + a * tx + b * ty),
                       (d * c + e * s, e * c - d * s, y_ + d * tx + e * ty), (0.0, 0.0, 1.0)))
@@ -511,31 +506,27 @@ def _check_kind(kind: Any) -> str:
     return kind
 
 
-def se2_family(kind: str = "invariant", *, gate: Any = None, fading: Any = None) -> FilterFamily:
+def se2_family(kind: str = "invariant") -> FilterFamily:
     r"""Les étapes de l'EKF invariant (``kind="invariant"``) ou standard (``"standard"``) sur SE(2) pour le
     moteur ; état interne :math:`(\hat T, P)` ((3, 3) et (3, 3), ou (N, 3, 3) et (N, 3, 3) en lot).
 
-    ``gate`` (probabilité :math:`0 < p < 1`) : une position dont la NIS :math:`\nu^TS^{-1}\nu` dépasse
-    :math:`\chi^2_2(p)` est rejetée (prédiction seule, ``n_iter`` = 0) ; ``fading`` (:math:`\alpha \ge 1`) :
-    :math:`P_{k+1\mid k} = \alpha^2FPF^T + GQG^T`. Ces deux options ne servent qu'au filtre d'un tirage."""
+    Les options du moteur (:func:`~kalman_course.filters.engine.run_filter`) s'appliquent comme à tout
+    filtre gaussien : la porte (``gate=p`` : une position dont la NIS :math:`z^TS^{-1}z` dépasse
+    :math:`\chi^2_2(p)` est rejetée, prédiction seule) et la mémoire évanescente (``fading=α`` :
+    :math:`P_{k+1\mid k} = \alpha^2FPF^T + GQG^T`), pour un tirage."""
     kind = _check_kind(kind)
-    p_gate = gate_probability(gate)
-    alpha2 = fading_factor(fading)
     step_predict = _invariant_predict if kind == "invariant" else _standard_predict
-    threshold = None if p_gate is None else gate_threshold(p_gate, 2)
 
     def prior(model, T0, P0):
         return _check_step(T0, P0, "T0", "P0")
 
     def predict(model, state, u):
-        return step_predict(model, state[0], state[1], u, alpha2)
+        return step_predict(model, state[0], state[1], u)
 
     def update(model, state, y, idx):
         T, P = state
         z = _innovation(kind, T, y)
         S, K = _gain(P, model.gnss_std**2)
-        if threshold is not None and nis_value(z, S) > threshold:
-            return state, Correction(np.zeros((3, 2)), z, S, 0)
         return _correct(kind, T, P, z, K), Correction(K, z, S)
 
     def prior_many(model, T0, P0, N, shared=False):
@@ -548,8 +539,6 @@ def se2_family(kind: str = "invariant", *, gate: Any = None, fading: Any = None)
     def update_many(model, state, Y, idx, k):
         return _batch_update(kind, model, state[0], state[1], Y)
 
-    if p_gate is not None or alpha2 is not None:  # options d'un tirage seulement
-        prior_many = predict_many = update_many = None
     return FilterFamily(
         name=_NAMES[kind],
         model_type=OdometryGnssModel,
@@ -565,6 +554,8 @@ def se2_family(kind: str = "invariant", *, gate: Any = None, fading: Any = None)
         predict_many=predict_many,
         update_many=update_many,
         batch_controls=True,
+        inflate=lambda state, alpha: (state[0], alpha * alpha * state[1]),
+        gating=True,
     )
 
 
@@ -590,11 +581,11 @@ def _check_odometry(u: Any) -> Any:
 
 
 def _filter(kind, model, y, T0, P0, u, gate, fading) -> SE2FilterResult:
-    family = se2_family(kind, gate=gate, fading=fading)
+    family = se2_family(kind)
     _check_model(model)
     Y = as_measurements("y", y, 2)
     _check_whole_rows("y", Y)
-    res = run_filter(family, model, Y, T0, P0, _check_odometry(u))
+    res = run_filter(family, model, Y, T0, P0, _check_odometry(u), gate=gate, fading=fading)
     return _with_world(res, SE2FilterResult, kind)
 
 

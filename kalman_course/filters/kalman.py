@@ -43,7 +43,7 @@ from ..core.linalg import (
 from ..core.models import LinearGaussianModel
 from ..core.results import FilterResult, FilterRuns
 from ..core.validation import KalmanInputError, as_gaussian, as_vector, check_control_allowed
-from .gating import fading_factor, gate_probability, gate_threshold, nis_value
+from .gating import fading_factor
 from .engine import (
     Correction, FilterFamily, gaussian_moments, gaussian_prior, gaussian_prior_many, run_filter, run_filter_runs,
 )
@@ -124,10 +124,10 @@ def predict(model: LinearGaussianModel, x: Any, P: Any, u: Any = None, *, fading
     ``fading`` : facteur :math:`\alpha \ge 1` de mémoire évanescente, :math:`P_{k\mid k-1} = \alpha^2AP
     A^T + Q` (:mod:`~kalman_course.filters.gating`). Modèle variable dans le temps : passez ``model.at(k)``.
     """
-    alpha2 = fading_factor(fading)
+    alpha = fading_factor(fading)
     x_arr, P_arr = _check_state(x, P, model.n_state, "x", "P")
-    if alpha2 is not None:
-        P_arr = alpha2 * P_arr
+    if alpha is not None:
+        P_arr = alpha**2 * P_arr
     x_pred, P_pred = _predict(x_arr, P_arr, model.A, model.Q, _control_term(model, u))
     return Prediction(x_pred, P_pred)
 
@@ -222,12 +222,13 @@ def kalman_filter(
     form : ``"square_root"`` (par défaut : racine carrée de :math:`P`, sûre pour un :math:`P_0` vague),
         ``"textbook"`` (:math:`P = (I - KC)P^-`, la formule du cours) ou ``"joseph"`` — voir l'en-tête
         du module.
-    gate : probabilité :math:`0 < p < 1`, optionnelle — **porte** : une mesure dont la NIS
-        :math:`\nu_k^TS_k^{-1}\nu_k` dépasse le quantile :math:`\chi^2_{m_k}(p)` (:math:`m_k` composantes
-        observées) est rejetée et le pas se réduit à la prédiction (:mod:`~kalman_course.filters.gating`).
-        Un pas rejeté garde son innovation et sa covariance ``S`` (son NIS se lit par
-        :func:`~kalman_course.nis`), avec un gain nul ; ``result.rejected`` (T,) marque ces pas.
-    fading : facteur :math:`\alpha \ge 1`, optionnel — **mémoire évanescente** :
+    gate : probabilité :math:`0 < p < 1`, optionnelle — **porte** (option du moteur,
+        :mod:`~kalman_course.filters.gating`) : une mesure dont la NIS :math:`\nu_k^TS_k^{-1}\nu_k` dépasse
+        le quantile :math:`\chi^2_{m_k}(p)` (:math:`m_k` composantes observées) est rejetée et le pas se
+        réduit à la prédiction, comme si la mesure manquait. Un pas rejeté garde son innovation et sa
+        covariance ``S`` (son NIS se lit par :func:`~kalman_course.nis`), avec un gain nul ;
+        ``result.rejected`` (T,) marque ces pas, que la log-vraisemblance ne compte pas.
+    fading : facteur :math:`\alpha \ge 1`, optionnel — **mémoire évanescente** (option du moteur) :
         :math:`P_{k\mid k-1} = \alpha^2 A P_{k-1\mid k-1}A^T + Q` (``KalmanFilter.alpha`` de filterpy).
 
     ``model`` peut varier dans le temps (matrices (T, …), voir
@@ -240,7 +241,7 @@ def kalman_filter(
         ``x`` (T, n), ``P`` (T, n, n), ``x_pred``, ``P_pred``, ``K`` (T, n, m), ``innovation`` (T, m),
         ``S`` (T, m, m), ``observed`` (T, m), ``rejected`` (T,).
     """
-    return run_filter(kalman_family(form, gate=gate, fading=fading), model, y, x0, P0, u)
+    return run_filter(kalman_family(form), model, y, x0, P0, u, gate=gate, fading=fading)
 
 
 def kalman_filter_runs(
@@ -304,7 +305,7 @@ def _observed_part(model: LinearGaussianModel, idx: np.ndarray | None, square_ro
     return model.C[idx], (covariance_root(R) if square_root else R)
 
 
-def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None) -> FilterFamily:
+def kalman_family(form: str = FORMS[0]) -> FilterFamily:
     r"""Les étapes du filtre de Kalman linéaire pour le moteur, un tirage
     (:func:`~kalman_course.filters.engine.run_filter`) ou ``N`` à la fois
     (:func:`~kalman_course.filters.engine.run_filter_runs`).
@@ -317,13 +318,12 @@ def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None)
     racine sont communes à tous les tirages (n, n) (Riccati commune) ou une par tirage (N, n, n) ; la
     commande est (p,) ou (N, p).
 
-    ``gate`` et ``fading`` (voir :func:`kalman_filter`) ne servent qu'au filtre d'un tirage : leurs étapes
-    enveloppent ``predict`` (covariance multipliée par :math:`\alpha^2`, racine par :math:`\alpha`) et
-    ``update`` (NIS comparé au seuil avant la correction)."""
+    Options du moteur (:mod:`~kalman_course.filters.gating`) : mémoire évanescente (``inflate`` : la
+    covariance multipliée par :math:`\alpha^2`, sa racine par :math:`\alpha`), porte (la correction rend
+    :math:`\nu` et :math:`S`, ou sa racine), adaptation de :math:`Q` (``noise_image`` :
+    :math:`G = CQC^T`)."""
     form = _check_form(form)
     square_root, joseph = form == "square_root", form == "joseph"
-    p_gate = gate_probability(gate)
-    alpha2 = fading_factor(fading)
 
     def predict_mean(model, x, u):  # x̂⁻ = A x̂ + B u ; x (n,) ou une ligne par tirage (N, n)
         x_pred = x.dot(model.A.T)
@@ -405,10 +405,13 @@ def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None)
             X, P, K, S = correct_many(X_pred, P_pred, nu, C, R, joseph, where)
             return (X, P), Correction(K, nu, S)
 
-    if alpha2 is not None:
-        predict = _faded(predict, alpha2, square_root)
-    if p_gate is not None:
-        update = _gated(update, p_gate, square_root)
+    def inflate(state, alpha):  # mémoire évanescente : P ← α² P (en racine carrée, M ← α M)
+        return (state[0], (alpha if square_root else alpha * alpha) * state[1])
+
+    def noise_image(model, predicted, idx):  # G = C Q Cᵀ sur les composantes observées
+        C = model.C if idx is None else model.C[idx]
+        return C.dot(model.Q).dot(C.T)
+
     return FilterFamily(
         name="filtre de Kalman",
         model_type=LinearGaussianModel,
@@ -423,40 +426,7 @@ def kalman_family(form: str = FORMS[0], *, gate: Any = None, fading: Any = None)
         update_many=update_many,
         batch_controls=True,
         shared_covariance=True,
+        inflate=inflate,
+        gating=True,
+        noise_image=noise_image,
     )
-
-
-def _faded(predict, alpha2: float, square_root: bool):
-    r"""Prédiction à mémoire évanescente : :math:`P_{k\mid k-1} = \alpha^2 A P A^T + Q` (en racine carrée,
-    la racine de :math:`P` multipliée par :math:`\alpha`)."""
-    scale = float(np.sqrt(alpha2)) if square_root else alpha2
-
-    def faded(model, state, u):
-        x, P = state  # P, ou sa racine
-        return predict(model, (x, scale * P), u)
-
-    return faded
-
-
-def _gated(update, p_gate: float, square_root: bool):
-    r"""Correction derrière une porte : si la NIS :math:`\nu^TS^{-1}\nu` dépasse :math:`\chi^2_{m_k}(p)`, la
-    mesure est rejetée (état prédit inchangé, gain nul, ``n_iter`` = 0 : ``result.rejected``).
-
-    En racine carrée, l'état porte une racine :math:`M` de :math:`P^-` : :math:`S = (MC^T)^T(MC^T) + R`, et
-    un pas rejeté rend la racine de :math:`S` (``Correction.S``, comme la correction)."""
-
-    def gated(model, state, y, idx):
-        x_pred = state[0]
-        C, R = _observed_part(model, idx, False)
-        nu = y - C.dot(x_pred)
-        if square_root:  # state[1] : racine M de P⁻
-            MCt = state[1].dot(C.T)
-            S = symmetrize(MCt.T.dot(MCt) + R)
-        else:  # state[1] : P⁻
-            S = symmetrize(C.dot(state[1]).dot(C.T) + R)
-        if nis_value(nu, S) > gate_threshold(p_gate, len(nu)):
-            K = np.zeros((len(x_pred), len(nu)))
-            return state, Correction(K, nu, covariance_root(S) if square_root else S, 0)
-        return update(model, state, y, idx)
-
-    return gated

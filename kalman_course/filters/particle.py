@@ -32,6 +32,7 @@ from typing import Any, Callable, NamedTuple
 import numpy as np
 import scipy.linalg
 
+from ..core.angles import wrap_angle
 from ..core.linalg import centred_rows, covariance_factor, psd_solve, symmetrize, weighted_rows
 from ..core.models import NonlinearModel
 from ..core.results import FilterResult
@@ -39,6 +40,7 @@ from ..core.simulation import as_generator, check_positive_int
 from ..core.validation import KalmanInputError, array_text, as_float_array, as_gaussian, shape_text
 from .engine import Correction, FilterFamily, run_filter
 from .extended import NONLINEAR_HINT
+from .gaussian import weighted_mean
 
 __all__ = [
     "RESAMPLING_SCHEMES",
@@ -315,6 +317,22 @@ def _weighted_moments(X: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndar
     return x, symmetrize(D.T.dot(WD)), WD
 
 
+def _measurement_moments(HX: np.ndarray, w: np.ndarray, angles: list[int]):
+    r"""Moments pondérés des mesures prédites ``HX`` (N, m) : :math:`\hat y`, :math:`P_{yy}` et
+    :math:`w^i(h(x^i) - \hat y)` (N, m), comme :func:`_weighted_moments`, mais les composantes angulaires
+    ``angles`` (un azimut près de :math:`\pm\pi`) ont une **moyenne circulaire**
+    :math:`\operatorname{atan2}(\sum_i w^i\sin, \sum_i w^i\cos)` et des écarts ramenés dans
+    :math:`(-\pi, \pi]` : sans cela, un nuage à cheval sur :math:`\pm\pi` aurait une moyenne proche de 0 et
+    un écart-type de l'ordre de :math:`\pi`."""
+    if not angles:
+        return _weighted_moments(HX, w)
+    y_hat = weighted_mean(HX, w, angles)
+    D = HX - y_hat
+    D[:, angles] = wrap_angle(D[:, angles])
+    WD = weighted_rows(w, D)
+    return y_hat, symmetrize(D.T.dot(WD)), WD
+
+
 def _cloud_moments(X: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     r""":math:`(\hat x, P, X - \hat x)` du nuage ``X`` (N, n) de poids ``w`` (N,)."""
     x = w.dot(X)
@@ -377,9 +395,10 @@ def particle_family(
         w /= w.sum()  # efface les arrondis (Σw = 1 à 1e-16 près)
         ess = float(1.0 / np.dot(w, w))
         # correction « linéaire équivalente » du nuage prédit : ŷ, S, P_xy, K = P_xy S⁻¹ (pour la NIS) ;
-        # P_xy = Σ wⁱ(xⁱ − x̂⁻)(h(xⁱ) − ŷ)ᵀ avec les écarts xⁱ − x̂⁻ du nuage prédit (déjà calculés)
+        # P_xy = Σ wⁱ(xⁱ − x̂⁻)(h(xⁱ) − ŷ)ᵀ avec les écarts xⁱ − x̂⁻ du nuage prédit (déjà calculés) ;
+        # composantes angulaires de la mesure : moyenne circulaire et écarts ramenés dans (−π, π]
         D = (state.moments or _cloud_moments(X, w_prev))[2]
-        y_hat, Pyy, WDy = _weighted_moments(HX, w_prev)
+        y_hat, Pyy, WDy = _measurement_moments(HX, w_prev, model.observed_angles(idx))
         S = Pyy + R
         Pxy = D.T.dot(WDy)
         K = psd_solve(S, Pxy.T, message=f"Filtre particulaire, correction par y[{state.k}] : la covariance "

@@ -38,7 +38,7 @@ Ce module n'importe pas matplotlib.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.linalg
@@ -51,7 +51,8 @@ from .diffuse import DiffuseFilterResult, is_determined
 from .extended import NONLINEAR_HINT
 
 __all__ = ["SmootherResult", "rts_smoother", "extended_rts_smoother", "unscented_rts_smoother", "smoother_gains",
-           "rts_pass", "square_root_rts_pass", "diffuse_rts_pass", "CONSISTENCY_RTOL"]
+           "rts_pass", "square_root_rts_pass", "diffuse_rts_pass", "CONSISTENCY_RTOL", "LinearSmootherInputs",
+           "linear_smoother_inputs"]
 
 #: Tolérance relative de la vérification « ce résultat vient du filtre de ce modèle ».
 CONSISTENCY_RTOL = 1e-6
@@ -220,14 +221,15 @@ def diffuse_rts_pass(A: np.ndarray, augmented: FilterResult, J: np.ndarray, h: n
         \hat x_{k\mid T} = a^s_k + X^s_kJ_T^{-1}h_T,\quad P_{k\mid T} = P^{a,s}_k + X^s_kJ_T^{-1}X^{sT}_k,\quad
         \operatorname{Cov}(x_{k+1}, x_k\mid y) = P^{a,s}_{k+1}G^{aT}_k + X^s_{k+1}J_T^{-1}X^{sT}_k.
 
-    ``A`` (n, n) ; ``augmented`` : le filtre augmenté (``x``, ``x_pred`` (T, n, 1+n), ``P``, ``P_pred``
-    (T, n, n)) ; ``J`` (n, n) définie positive, ``h`` (n,) : :math:`J_T`, :math:`h_T`. Renvoie
+    ``A`` (n, n), ou (T, n, n) les matrices de chaque pas d'un modèle variable dans le temps (la ligne
+    ``k`` prédite par :math:`A_k`) ; ``augmented`` : le filtre augmenté (``x``, ``x_pred`` (T, n, 1+n), ``P``,
+    ``P_pred`` (T, n, n)) ; ``J`` (n, n) définie positive, ``h`` (n,) : :math:`J_T`, :math:`h_T`. Renvoie
     ``(x (T, n), P (T, n, n), P_lag (T, n, n))`` (``P_lag[0]`` NaN)."""
-    n = A.shape[0]
+    n = A.shape[-1]
     G_a = np.zeros_like(augmented.P)
     T = G_a.shape[0]
     if T > 1:
-        G_a[:-1] = smoother_gains(augmented.P[:-1], augmented.P_pred[1:], A)
+        G_a[:-1] = smoother_gains(augmented.P[:-1], augmented.P_pred[1:], A if A.ndim == 2 else A[1:])
     xs_a, Ps_a, lag_a = rts_pass(augmented.x, augmented.P, augmented.x_pred, augmented.P_pred, G_a)
     Xs = xs_a[:, :, 1:]
     cho = scipy.linalg.cho_factor(J, lower=True)
@@ -254,13 +256,21 @@ def _check_order(model: Any, result: Any, call: str) -> None:
         )
 
 
-def _check_result(result: Any) -> FilterResult:
+def _check_result(result: Any, call: str = "rts_smoother", filter_call: str = "kalman_filter") -> FilterResult:
+    """``result`` doit être la sortie d'un filtre (un tirage) ; des mesures à sa place reçoivent l'appel juste :
+    tous les lisseurs prennent ``(model, result, x0, P0, u)``."""
     if isinstance(result, FilterRuns):
         raise KalmanInputError(
-            "« result » est un lot de tirages (FilterRuns) : lissez un tirage à la fois, par exemple "
-            "rts_smoother(model, runs.run(0))."
+            f"« result » est un lot de tirages (FilterRuns) : lissez un tirage à la fois, par exemple "
+            f"{call}(model, runs.run(0))."
         )
-    check_instance("result", result, FilterResult, "la sortie d'un filtre, par exemple kalman_filter")
+    if isinstance(result, (np.ndarray, list, tuple)):
+        raise KalmanInputError(
+            f"« result » est un tableau ({type(result).__name__}) : tous les lisseurs du paquet lissent la sortie "
+            f"d'un filtre, {call}(model, result, x0, P0, u) ; filtrez d'abord les mesures : "
+            f"{call}(model, {filter_call}(model, y, x0, P0), x0, P0)."
+        )
+    check_instance("result", result, FilterResult, f"la sortie d'un filtre, par exemple {filter_call}")
     if result.x.ndim != 2:
         raise KalmanInputError(
             f"« result » a des états de forme {result.x.shape[1:]} : le lisseur RTS attend des vecteurs "
@@ -336,9 +346,10 @@ def _initial(model_n: int, x0: Any, P0: Any):
     return as_gaussian(x0, P0, model_n, "x0", "P0")
 
 
-def _smooth_initial(x0, P0, F0, Q0, fx0, result: FilterResult, xs0, Ps0):
-    """Lisse l'état initial (instant 0) : vérifie que ``(x0, P0)`` est l'a priori du filtre."""
-    P_pred0 = symmetrize(F0.dot(P0).dot(F0.T) + Q0)
+def _check_prior(P_pred0, fx0, result: FilterResult) -> None:
+    """``(x0, P0)`` doit être l'a priori du filtre : sa prédiction ``P_pred0`` (:math:`F_0P_0F_0^T + Q_0`)
+    redonne ``result.P_pred[0]`` (et ``fx0``, :math:`f(x_0)`, redonne ``result.x_pred[0]`` si elle est
+    donnée)."""
     ref = result.P_pred[0]
     if np.max(np.abs(P_pred0 - ref)) > CONSISTENCY_RTOL * max(np.max(np.abs(ref)), np.finfo(float).tiny):
         raise KalmanInputError(
@@ -352,6 +363,12 @@ def _smooth_initial(x0, P0, F0, Q0, fx0, result: FilterResult, xs0, Ps0):
                 "« x0 » n'est pas l'a priori du filtre : sa prédiction ne redonne pas result.x_pred[0]. "
                 "Donnez les x0, P0 passés au filtre."
             )
+
+
+def _smooth_initial(x0, P0, F0, Q0, fx0, result: FilterResult, xs0, Ps0):
+    """Lisse l'état initial (instant 0) : vérifie que ``(x0, P0)`` est l'a priori du filtre."""
+    _check_prior(symmetrize(F0.dot(P0).dot(F0.T) + Q0), fx0, result)
+    ref = result.P_pred[0]
     try:  # en racine carrée (voir square_root_rts_pass) : sûr pour un a priori vague
         _, U_cond, G0, _ = correct_square_root(x0, covariance_root(P0), np.zeros(len(x0)), F0, covariance_root(Q0))
         U_init = triangular_root(np.concatenate((U_cond, covariance_root(Ps0).dot(G0.T))))
@@ -363,10 +380,64 @@ def _smooth_initial(x0, P0, F0, Q0, fx0, result: FilterResult, xs0, Ps0):
     return x_init, P_init, G0, Ps0.dot(G0.T)
 
 
+class LinearSmootherInputs(NamedTuple):
+    r"""Ce que les lisseurs linéaires lisent, vérifié (:func:`linear_smoother_inputs`) : ``A`` (T, n, n) et
+    ``Q`` (T, n, n) les matrices de chaque pas (la ligne ``k`` est prédite depuis la ligne ``k-1`` par
+    :math:`A_k`), ``prior`` :math:`(\hat x_0, P_0)` ou ``None``, ``U`` (T, p) ou ``None``."""
+
+    A: np.ndarray
+    Q: np.ndarray
+    prior: tuple[np.ndarray, np.ndarray] | None
+    U: np.ndarray | None
+
+
+def linear_smoother_inputs(model: Any, result: Any, x0: Any, P0: Any, u: Any, call: str = "rts_smoother",
+                           filter_call: str = "kalman_filter", diffuse: bool = True) -> LinearSmootherInputs:
+    r"""Les vérifications communes des lisseurs linéaires (``lisseur(model, result, x0, P0, u)`` :
+    :func:`rts_smoother`, :func:`~kalman_course.parallel_rts_smoother`) : ordre des arguments, ``model``
+    linéaire, ``result`` d'un filtre de ce modèle (dimensions, valeurs déterminées, prédictions
+    :math:`P^-_{k+1} = A_{k+1}P_kA_{k+1}^T + Q_{k+1}` et :math:`\hat x^-_{k+1} = A_{k+1}\hat x_k + B_{k+1}u_{k+1}`
+    retrouvées, :math:`S_k`), et l'a priori ``(x0, P0)`` du filtre s'il est donné. ``diffuse=False`` : un
+    résultat de :func:`~kalman_course.diffuse_kalman_filter` est refusé (``call`` ne le lisse pas)."""
+    _check_order(model, result, call)
+    check_instance("model", model, LinearGaussianModel, "pour un modèle non linéaire, utilisez extended_rts_smoother")
+    result = _check_result(result, call, filter_call)
+    if isinstance(result, DiffuseFilterResult) and not diffuse:
+        raise KalmanInputError(
+            f"« result » vient de diffuse_kalman_filter : {call} ne lisse pas l'initialisation diffuse ; "
+            "lissez-le avec rts_smoother(model, result)."
+        )
+    n, m, T = model.n_state, model.n_obs, result.n_steps
+    _check_dimensions(result, n, m)
+    _check_finite(result)
+    U = as_controls("u", u, T, model.n_control)
+    A, Q = np.asarray(model.sequence("A", T)), np.asarray(model.sequence("Q", T))
+    x, P = result.x, result.P
+    x_next = None
+    if model.B is None:
+        x_next = (A[1:] @ x[:-1, :, None])[:, :, 0]
+    elif U is not None:
+        Bu = (np.asarray(model.sequence("B", T)) @ U[:, :, None])[:, :, 0]
+        x_next = (A[1:] @ x[:-1, :, None])[:, :, 0] + Bu[1:]
+    C, R = (model.sequence("C", T), model.sequence("R", T)) if model.time_varying else (model.C, model.R)
+    _check_consistency(result, symmetrize(A[1:] @ P[:-1] @ np.swapaxes(A[1:], 1, 2) + Q[1:]), x_next, C, R,
+                       "filtre de Kalman", f" ({call} lisse la sortie de {filter_call})")
+    prior = _initial(n, x0, P0)
+    if prior is not None:
+        fx0 = None
+        if model.B is None:
+            fx0 = A[0].dot(prior[0])
+        elif U is not None:
+            fx0 = A[0].dot(prior[0]) + np.asarray(model.sequence("B", T))[0].dot(U[0])
+        _check_prior(symmetrize(A[0].dot(prior[1]).dot(A[0].T) + Q[0]), fx0, result)
+    return LinearSmootherInputs(A, Q, prior, U)
+
+
 # --------------------------------------------------------------------------- lisseurs
 
 
-def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = None, P0: Any = None) -> SmootherResult:
+def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = None, P0: Any = None,
+                 u: Any = None) -> SmootherResult:
     r"""Lisseur de Rauch–Tung–Striebel pour un résultat du filtre de Kalman linéaire.
 
     .. math::
@@ -375,14 +446,21 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
         \hat x_{k\mid T} = \hat x_{k\mid k} + G_k(\hat x_{k+1\mid T} - \hat x_{k+1\mid k}),\quad
         P_{k\mid T} = P_{k\mid k} + G_k(P_{k+1\mid T} - P_{k+1\mid k})G_k^T.
 
+    **La forme de tous les lisseurs du paquet** : ``lisseur(model, result, x0, P0, u)`` — le modèle, la
+    sortie du filtre (comme un filtre prend les mesures), l'a priori du filtre et ses commandes, tous
+    positionnels et facultatifs après ``result`` ; puis les options par leur nom. Le lisseur ne refiltre pas :
+    il lisse le résultat qu'on lui donne (celui de :func:`~kalman_course.kalman_filter`, d'un filtre à porte,
+    du filtre parallèle…), après avoir vérifié qu'il vient bien de ce modèle.
+
     Paramètres
     ----------
-    model : LinearGaussianModel — celui du filtre.
+    model : LinearGaussianModel — celui du filtre (constant ou variable dans le temps).
     result : FilterResult de :func:`~kalman_course.kalman_filter` (mesures manquantes et commandes
         comprises), ou :class:`~kalman_course.filters.diffuse.DiffuseFilterResult` de
         :func:`~kalman_course.diffuse_kalman_filter` (initialisation diffuse exacte, voir plus bas).
     x0 : (n,), P0 : (n, n), optionnels — l'a priori donné au filtre : l'état initial (instant 0) est
         alors lissé aussi (``x_initial``, ``P_initial``, ``G_initial``, ``P_lag[0]``).
+    u : (T, p), optionnel — les commandes données au filtre (elles servent à vérifier ses prédictions).
 
     Initialisation diffuse : sachant :math:`\delta` (l'état de la première mesure), le filtre augmenté est un
     filtre ordinaire ; on lisse ses moyennes :math:`[a \mid X]` (affines en :math:`\delta`) et sa
@@ -394,33 +472,21 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
     Renvoie un :class:`SmootherResult` (``x`` (T, n), ``P`` (T, n, n), ``G``, ``P_lag``).
     """
     _check_order(model, result, "rts_smoother")
-    check_instance("model", model, LinearGaussianModel, "pour un modèle non linéaire, utilisez extended_rts_smoother")
-    result = _check_result(result)
-    n, m = model.n_state, model.n_obs
     if isinstance(result, DiffuseFilterResult):
+        check_instance("model", model, LinearGaussianModel,
+                       "pour un modèle non linéaire, utilisez extended_rts_smoother")
         if x0 is not None or P0 is not None:
             raise KalmanInputError(
                 "« x0 », « P0 » : un résultat de diffuse_kalman_filter n'a pas d'a priori ; ne les donnez pas."
             )
-        return _diffuse_rts(model, result)
-    _check_dimensions(result, n, m)
-    _check_finite(result)
-    A = A0 = model.A
-    Q, Q0, C, R = model.Q, model.Q, model.C, model.R
+        return _diffuse_rts(model, result, u)
+    inputs = linear_smoother_inputs(model, result, x0, P0, u)
+    A, Q = inputs.A, inputs.Q
     x, P = result.x, result.P
-    if model.time_varying:  # les lignes k et k+1 sont reliées par les matrices du pas k+1
-        T = result.n_steps
-        A_all, Q_all = model.sequence("A", T), model.sequence("Q", T)
-        A, Q, A0, Q0 = A_all[1:], Q_all[1:], A_all[0], Q_all[0]
-        C, R = model.sequence("C", T), model.sequence("R", T)
-    At = np.swapaxes(A, -1, -2)
-    x_next = (x[:-1, None, :] @ At)[:, 0] if model.B is None else None
-    _check_consistency(result, symmetrize(A @ P[:-1] @ At + Q), x_next, C, R,
-                       "filtre de Kalman", " (rts_smoother lisse la sortie de kalman_filter)")
     sqrt_pass = None
     if not model.time_varying:  # en racine carrée : sûr pour un a priori vague (modèle constant)
         try:
-            sqrt_pass = square_root_rts_pass(x, P, result.x_pred, A, model.noise_roots[0])
+            sqrt_pass = square_root_rts_pass(x, P, result.x_pred, model.A, model.noise_roots[0])
         except KalmanInputError:  # P⁻ singulière : gains de moindres carrés, forme usuelle ci-dessous
             pass
     if sqrt_pass is not None:
@@ -428,14 +494,12 @@ def rts_smoother(model: LinearGaussianModel, result: FilterResult, x0: Any = Non
     else:  # modèle variable dans le temps, ou P⁻ singulière : gains de smoother_gains, forme usuelle
         G = np.zeros_like(P)
         if result.n_steps > 1:
-            G[:-1] = smoother_gains(P[:-1], result.P_pred[1:], A)
+            G[:-1] = smoother_gains(P[:-1], result.P_pred[1:], A[1:])
         xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
-    prior = _initial(n, x0, P0)
     initial = (None, None, None)
-    if prior is not None:
-        x0_arr, P0_arr = prior
-        *initial, lag[0] = _smooth_initial(x0_arr, P0_arr, A0, Q0, A0.dot(x0_arr) if model.B is None else None,
-                                           result, xs[0], Ps[0])
+    if inputs.prior is not None:
+        x0_arr, P0_arr = inputs.prior
+        *initial, lag[0] = _smooth_initial(x0_arr, P0_arr, A[0], Q[0], None, result, xs[0], Ps[0])
     return SmootherResult(xs, Ps, G, lag, *initial, method="RTS")
 
 
@@ -447,18 +511,19 @@ def _check_dimensions(result: FilterResult, n: int, m: int) -> None:
         )
 
 
-def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> SmootherResult:
-    if model.time_varying:
-        raise KalmanInputError(
-            "rts_smoother : le lissage d'une initialisation diffuse n'est écrit que pour un modèle constant ; pour un "
-            "modèle variable dans le temps, filtrez avec un a priori (kalman_filter(model, y, x0, P0))."
-        )
+def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult, u: Any = None) -> SmootherResult:
     aug = result.augmented
-    n = model.n_state
+    n, T = model.n_state, result.n_steps
     _check_dimensions(result, n, model.n_obs)
-    A = model.A
-    x_next = np.einsum("ij,tjc->tic", A, aug.x[:-1]) if model.B is None else None
-    _check_consistency(aug, symmetrize(A @ aug.P[:-1] @ A.T + model.Q), x_next, model.C, model.R,
+    U = as_controls("u", u, T, model.n_control)
+    A, Q = np.asarray(model.sequence("A", T)), np.asarray(model.sequence("Q", T))
+    x_next = None  # la ligne k+1 prédite depuis la ligne k, colonne a avec B u, colonnes X sans
+    if model.B is None or U is not None:
+        x_next = A[1:] @ aug.x[:-1]
+        if model.B is not None:
+            x_next[:, :, 0] += (np.asarray(model.sequence("B", T)) @ U[:, :, None])[1:, :, 0]
+    C, R = (model.sequence("C", T), model.sequence("R", T)) if model.time_varying else (model.C, model.R)
+    _check_consistency(aug, symmetrize(A[1:] @ aug.P[:-1] @ np.swapaxes(A[1:], 1, 2) + Q[1:]), x_next, C, R,
                        "filtre de Kalman à initialisation diffuse", " (diffuse_kalman_filter)")
     J, h = result.information[-1], result.information_vector[-1]
     if not is_determined(J):
@@ -472,7 +537,7 @@ def _diffuse_rts(model: LinearGaussianModel, result: DiffuseFilterResult) -> Smo
     G[-1] = 0.0
     ok = np.isfinite(result.P[:-1]).all(axis=(1, 2))
     if ok.any():
-        G[:-1][ok] = smoother_gains(result.P[:-1][ok], result.P_pred[1:][ok], A)
+        G[:-1][ok] = smoother_gains(result.P[:-1][ok], result.P_pred[1:][ok], A[1:][ok])
     return SmootherResult(xs, Ps, G, lag, method="RTS, initialisation diffuse exacte")
 
 
@@ -503,7 +568,7 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
     """
     _check_order(model, result, "extended_rts_smoother")
     model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
-    result = _check_result(result)
+    result = _check_result(result, "extended_rts_smoother", "extended_kalman_filter")
     if isinstance(result, DiffuseFilterResult):
         raise KalmanInputError("« result » vient du filtre à initialisation diffuse (linéaire) : lissez-le avec rts_smoother.")
     n, m, T = model.n_state, model.n_obs, result.n_steps
@@ -549,8 +614,9 @@ def extended_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any =
     return SmootherResult(xs, Ps, G, lag, *initial, method="RTS étendu")
 
 
-def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha: float | None = None,
-                           beta: float = 2.0, kappa: float | None = None, u: Any = None) -> SmootherResult:
+def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, x0: Any = None, P0: Any = None,
+                           u: Any = None, *, alpha: float | None = None, beta: float = 2.0,
+                           kappa: float | None = None) -> SmootherResult:
     r"""Lisseur RTS « unscented » (Särkkä, 2008) pour un résultat de
     :func:`~kalman_course.unscented_kalman_filter`, avec les mêmes paramètres :math:`(\alpha, \beta, \kappa)`.
 
@@ -570,16 +636,20 @@ def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha
     :math:`(\bar x, \bar P)` est la prédiction de l'UKF : on vérifie qu'elle redonne celle du résultat
     (même modèle, même filtre, mêmes paramètres). Sur un modèle linéaire avec :math:`\alpha = 1`,
     :math:`\beta = 2`, :math:`\kappa = 0`, c'est :func:`rts_smoother`. ``G`` (T, n, n), ``P_lag`` comme
-    :func:`rts_smoother`. Paramètres : ``alpha``, ``beta``, ``kappa`` : ceux du filtre, avec les mêmes règles
-    (``alpha`` et ``kappa`` obligatoires, ``beta = 2`` par défaut) ; ``u`` (T, p) : les commandes données au
-    filtre.
+    :func:`rts_smoother`.
+
+    Paramètres : la forme de tous les lisseurs, ``(model, result, x0, P0, u)`` (voir :func:`rts_smoother`) —
+    ``x0`` (n,), ``P0`` (n, n) : l'a priori du filtre, pour lisser aussi l'état initial (même étape depuis
+    :math:`(\hat x_0, P_0)`) ; ``u`` (T, p) : les commandes données au filtre ; puis ``alpha``, ``beta``,
+    ``kappa`` : ceux du filtre, avec les mêmes règles (``alpha`` et ``kappa`` obligatoires, ``beta = 2`` par
+    défaut).
     """
     from .gaussian import predict_gaussian
     from .unscented import UnscentedRule
 
     _check_order(model, result, "unscented_rts_smoother")
     model = check_instance("model", model, NonlinearModel, NONLINEAR_HINT.replace("kalman_filter", "rts_smoother"))
-    result = _check_result(result)
+    result = _check_result(result, "unscented_rts_smoother", "unscented_kalman_filter")
     n, m, T = model.n_state, model.n_obs, result.n_steps
     _check_dimensions(result, n, m)
     _check_finite(result)
@@ -599,4 +669,16 @@ def unscented_rts_smoother(model: NonlinearModel, result: FilterResult, *, alpha
                        ", les mêmes paramètres (alpha, beta, kappa) et les mêmes commandes « u » "
                        "(unscented_rts_smoother lisse la sortie d'unscented_kalman_filter)")
     xs, Ps, lag = rts_pass(x, P, result.x_pred, result.P_pred, G)
-    return SmootherResult(xs, Ps, G, lag, method="RTS unscented")
+    prior = _initial(n, x0, P0)
+    initial = (None, None, None)
+    if prior is not None:  # l'état initial : la même étape depuis (x̂₀, P₀)
+        x0_arr, P0_arr = prior
+        x_bar, P_bar, mom = predict_gaussian(rule, model, x0_arr, P0_arr, None if U is None else U[0],
+                                             "lissage de l'état initial")
+        _check_prior(P_bar, x_bar, result)
+        G0 = np.linalg.solve(P_bar, mom.cross.T).T
+        x_init = x0_arr + G0.dot(xs[0] - x_bar)
+        P_init = symmetrize(P0_arr + G0.dot(Ps[0] - P_bar).dot(G0.T))
+        initial = (x_init, P_init, G0)
+        lag[0] = Ps[0].dot(G0.T)
+    return SmootherResult(xs, Ps, G, lag, *initial, method="RTS unscented")

@@ -494,44 +494,50 @@ def square_root_information_filter(
         définie positive), voir :func:`srif_predict`.
     """
     model = _check_linear(model)
-    family = srif_family(model, method)
+    family = srif_family(method)
     prior = _initial_information(model.n_state, x0, P0, R0, z0)
     return run_filter(family, model, y, prior, None, u)
 
 
-def srif_family(model: LinearGaussianModel, method: str = "inverse") -> FilterFamily:
-    """Les étapes du SRIF pour le moteur, pour ce ``model`` : les factorisations constantes (LU de
-    :math:`A` ou facteur de Cholesky de :math:`Q`, facteur du bruit d'état, facteur de :math:`R`) sont
-    calculées une seule fois ici, pas à chaque pas. L'a priori passé au moteur est un
+def srif_family(method: str = "inverse") -> FilterFamily:
+    """Les étapes du SRIF pour le moteur. Chaque étape reçoit le modèle du pas (``model.at(k)`` pour un
+    modèle variable dans le temps) ; ses factorisations (LU de :math:`A` ou facteur de Cholesky de :math:`Q`,
+    facteur du bruit d'état, facteur de :math:`R`) sont calculées une fois par modèle de pas et gardées pour
+    la durée du filtrage (une seule fois pour un modèle constant). L'a priori passé au moteur est un
     :class:`SquareRootInformation` (voir :func:`square_root_information_filter`)."""
-    model = _check_linear(model)
     method = _check_method(method)
-    A, C, Rm = model.A, model.C, model.R
-    if method == "inverse":
-        lu, G = _lu_invertible(A), noise_factor(model.Q)
+    factors: dict[int, tuple] = {}  # id(modèle du pas) → (modèle, prédiction, facteur de R)
 
-        def time_update(R, z, c):
-            return _time_update_inverse(R, z, lu, G, c)
-    else:
-        L = _joint_factor(model.Q)
+    def factored(model: LinearGaussianModel):
+        entry = factors.get(id(model))
+        if entry is None or entry[0] is not model:
+            if method == "inverse":
+                lu, G = _lu_invertible(model.A), noise_factor(model.Q)
 
-        def time_update(R, z, c):
-            return _time_update_joint(R, z, A, L, c)
+                def time_update(R, z, c):
+                    return _time_update_inverse(R, z, lu, G, c)
+            else:
+                A, L = model.A, _joint_factor(model.Q)
 
-    Ra_full = _upper_cholesky("R", Rm)
+                def time_update(R, z, c):
+                    return _time_update_joint(R, z, A, L, c)
+
+            entry = factors[id(model)] = (model, time_update, _upper_cholesky("R", model.R))
+        return entry
 
     def prior(model, info, _):
         return _with_rank(info.R, info.z, 0.0)
 
     def predict_step(model, state: _Information, u):
-        R, z, scale = time_update(state.R, state.z, None if u is None else model.B.dot(u))
+        R, z, scale = factored(model)[1](state.R, state.z, None if u is None else model.B.dot(u))
         return _with_rank(R, z, scale)
 
     def update_step(model, state: _Information, y, idx):
+        _, _, Ra_full = factored(model)
         if idx is None:
-            C_k, R_k, Ra = C, Rm, Ra_full
+            C_k, R_k, Ra = model.C, model.R, Ra_full
         else:
-            C_k, R_k = C[idx], Rm[np.ix_(idx, idx)]
+            C_k, R_k = model.C[idx], model.R[np.ix_(idx, idx)]
             Ra = _upper_cholesky("R", R_k)
         R, z, _, scale = _measurement_update(state.R, state.z, C_k, Ra, y)
         post = _with_rank(R, z, scale, already_full=state.full)

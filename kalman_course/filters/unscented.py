@@ -266,6 +266,8 @@ def unscented_kalman_filter(
     alpha: float | None = None,
     beta: float = 2.0,
     kappa: float | None = None,
+    gate: Any = None,
+    fading: Any = None,
 ) -> FilterResult:
     r"""Filtre de Kalman unscented sur toutes les mesures (pour chaque ``y[k]`` : prédiction puis
     correction, dans l'ordre de :func:`~kalman_course.kalman_filter`).
@@ -282,12 +284,14 @@ def unscented_kalman_filter(
         ``alpha`` et ``kappa`` : le bon choix dépend du problème ; :math:`\beta = 2` est optimal pour une
         loi gaussienne). :math:`\alpha = 1, \beta = 2, \kappa = 0` redonne exactement le filtre de Kalman
         sur un modèle linéaire.
+    gate, fading : porte et mémoire évanescente, options du moteur (:mod:`~kalman_course.filters.gating`),
+        comme pour :func:`~kalman_course.kalman_filter`.
 
     Renvoie un :class:`~kalman_course.FilterResult` (``x``, ``P``, ``x_pred``, ``P_pred``, ``K``,
     ``innovation`` :math:`y - \hat y`, ``S``). Une covariance qui cesse d'être définie positive lève une
     :class:`~kalman_course.KalmanInputError` qui nomme l'étape et la mesure.
     """
-    return run_filter(unscented_family(alpha, beta, kappa), model, y, x0, P0, u)
+    return run_filter(unscented_family(alpha, beta, kappa), model, y, x0, P0, u, gate=gate, fading=fading)
 
 
 def unscented_kalman_filter_runs(

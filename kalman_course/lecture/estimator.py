@@ -139,8 +139,8 @@ def linear_estimator(
     y: Any,
     x0_hat: Any,
     K: Any,
-    *,
     u: Any = None,
+    *,
     A_f: Any = None,
     B_f: Any = None,
 ) -> np.ndarray:
@@ -169,8 +169,8 @@ def linear_estimator_runs(
     Y: Any,
     x0_hat: Any,
     K: Any,
-    *,
     u: Any = None,
+    *,
     A_f: Any = None,
     B_f: Any = None,
 ) -> np.ndarray:

@@ -34,6 +34,7 @@ from .invariant import SE2_EXP, SE2_INVARIANT_PREDICT, SE2_INVARIANT_UPDATE
 from .sampling import PARTICLE_WEIGHTS, SIGMA_POINTS, SYSTEMATIC_RESAMPLE, UNSCENTED_TRANSFORM
 from .smoothing import EM_M_STEP, RTS_STEP
 from .tracking import CV_MODEL, IMM_MERGE, IMM_MIX, MODE_PROBABILITIES, NIS_GATE, VAN_LOAN
+from .assimilation import ETKF_UPDATE, GASPARI_COHN  # assimilation de données (issue 33)
 from .verdict import Verdict
 
 __all__ = ["Attempt", "Case", "Exercise", "Mistake", "Output", "Verdict", "attempt", "check", "exercise", "exercises",
@@ -45,6 +46,7 @@ _EXERCISES: tuple[Exercise, ...] = (
     SIGMA_POINTS, UNSCENTED_TRANSFORM, SYSTEMATIC_RESAMPLE, PARTICLE_WEIGHTS,
     RTS_STEP, EM_M_STEP,
     CV_MODEL, VAN_LOAN, NIS_GATE, IMM_MIX, MODE_PROBABILITIES, IMM_MERGE,
+    ETKF_UPDATE, GASPARI_COHN,
     PDA_WEIGHTS, PDA_UPDATE,
 )
 _BY_ID = {ex.id: ex for ex in _EXERCISES}

@@ -20,10 +20,12 @@ from . import tutorials  # noqa: F401  (travaux dirigés : les exemples calculé
 from . import helicopter, manoeuvre  # noqa: F401  (pistage : l'hélicoptère SAMU 31, la cible qui manœuvre)
 from . import grid_bayes  # noqa: F401  (filtre bayésien exact sur une grille : le modèle de croissance)
 from . import robot_localization  # noqa: F401  (robot plan, odométrie et GNSS : EKF invariant sur SE(2))
+from . import assimilation  # noqa: F401  (assimilation de données : Lorenz-63/96, expériences jumelles de DAPPER)
 from .radar import radar_iterations, radar_update_problem
 from .tag import position_rmse, run_tag_ekf, run_tag_ukf, tag_data, tag_model
 
 __all__ = [
+    "assimilation",
     "banana",
     "convergence",
     "distant_target",

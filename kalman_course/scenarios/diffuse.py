@@ -25,7 +25,8 @@ from ..core.models import LinearGaussianModel
 from ..core.results import freeze_fields
 from ..filters.square_root_information import square_root_information_filter
 from ..core.validation import KalmanInputError
-from ._motion import _cv_noise_gain, cv_process_noise, cv_transition, simulate_cv
+from ..core.motion import acceleration_gain, constant_velocity
+from ._motion import simulate_cv
 
 __all__ = [
     "DIFFUSE_DT",
@@ -65,7 +66,8 @@ def diffuse_model(accel_std: float = DIFFUSE_ACCEL_STD, fix_std: float = DIFFUSE
                   dt: float = DIFFUSE_DT) -> LinearGaussianModel:
     r"""Modèle à vitesse constante, mesure de la position : :math:`C = [I_2\ 0]`, :math:`R = \sigma^2 I_2`."""
     C = np.hstack([np.eye(2), np.zeros((2, 2))])
-    return LinearGaussianModel(cv_transition(dt), C, cv_process_noise(dt, accel_std), fix_std**2 * np.eye(2))
+    A, Q = constant_velocity(dt, accel_std=accel_std)
+    return LinearGaussianModel(A, C, Q, fix_std**2 * np.eye(2))
 
 
 def diffuse_data(n_steps: int = DIFFUSE_N_STEPS, rng=DIFFUSE_SEED):
@@ -127,8 +129,8 @@ def batch_estimates(y: np.ndarray, accel_std: float = DIFFUSE_ACCEL_STD, fix_std
     positions mesurées à :math:`\sigma` près), forme (T, 4) (ligne 0 : NaN, un seul relevé ne donne pas
     la vitesse)."""
     C = np.hstack([np.eye(2), np.zeros((2, 2))])
-    return batch_least_squares(cv_transition(dt), C, fix_std * np.eye(2), _cv_noise_gain(dt), y,
-                               La=accel_std * np.eye(2))
+    A = constant_velocity(dt, accel_std=accel_std).A
+    return batch_least_squares(A, C, fix_std * np.eye(2), acceleration_gain(dt), y, La=accel_std * np.eye(2))
 
 
 def extended_precision_estimates(model: LinearGaussianModel, y: np.ndarray, p0_exponent: int = 40,

@@ -13,7 +13,7 @@ Le code de l'étudiant n'interrompt jamais l'expérience : s'il échoue, ``stude
 * :func:`nile_lab` — TP 4 : le lisseur RTS et l'étape M de l'étudiant sur le Nil ;
 * :func:`samu_lab` — TP 5 : le modèle à vitesse presque constante, la porte, la discrétisation de Van Loan et
   l'IMM de l'étudiant sur le vol réel de l'hélicoptère SAMU 31.
-* :func:`pda_lab` — TP 6 : les poids et la correction PDA de l'étudiant, sur l'hélicoptère de la scène de
+* :func:`pda_lab` — TP 7 : les poids et la correction PDA de l'étudiant, sur l'hélicoptère de la scène de
   Blagnac dans un fouillis dense.
 """
 
@@ -34,7 +34,7 @@ from ..filters.smoothers import rts_smoother
 from ..filters.unscented import unscented_kalman_filter
 from ..likelihood import expectation_maximization
 from ..practice.nonlinear import point_function
-from ._motion import cv_transition
+from ..core.motion import constant_velocity
 from .nile import NILE_DK_VARIANCES, local_level_model
 from .pendulum import pendulum_data, pendulum_model, pendulum_observation, pendulum_transition
 from .tag import TAG_RANGE_STD, tag_data, tag_model, tag_ranges
@@ -66,7 +66,7 @@ LAB_SAMU_GATE = 0.999
 #: Densités (m²/s³) des régimes calme et agité de l'IMM du TP 5, et probabilité de quitter son régime.
 LAB_SAMU_MODES = (3.0, 100.0)
 LAB_SAMU_SWITCH = 0.02
-#: Densité du fouillis du TP 6 (par m² et par relevé : 44 fausses détections par relevé sur la zone).
+#: Densité du fouillis du TP 7 (par m² et par relevé : 44 fausses détections par relevé sur la zone).
 LAB_PDA_CLUTTER = 1e-7
 
 
@@ -131,7 +131,7 @@ def tag_lab(update: Callable | None = None, ranges_jacobian: Callable | None = N
     model = tag_model()
     ref = extended_kalman_filter(model, data.y, data.x0, data.P0)
     anchors = np.array(data.anchors)
-    linear = LinearGaussianModel(cv_transition(data.dt), np.eye(1, 4), np.array(model.Q), 1.0)
+    linear = LinearGaussianModel(constant_velocity(data.dt, accel_std=0.0).A, np.eye(1, 4), np.array(model.Q), 1.0)
     R = TAG_RANGE_STD**2 * np.eye(anchors.shape[0])
 
     def h(x):
@@ -369,7 +369,7 @@ def samu_lab(cv_model: Callable | None = None, nis_gate: Callable | None = None,
     return LabRun({"t": np.asarray(track.t), "y": y, "y_bad": y_bad, "outliers": outliers, "rate_t": rate_t,
                    "rate": rate}, reference, student, message)
 
-# --------------------------------------------------------------------------- TP 6 : la PDA
+# --------------------------------------------------------------------------- TP 7 : la PDA
 
 
 def pda_lab(pda_weights: Callable | None = None, pda_update: Callable | None = None) -> LabRun:

@@ -25,12 +25,13 @@ from functools import lru_cache
 import numpy as np
 
 from ..core.models import LinearGaussianModel
-from ..core.motion import constant_velocity, turn_transition
+from ..core.motion import constant_velocity
 from ..core.results import FilterResult, freeze_fields
 from ..diagnostics.consistency import nees
 from ..filters.adaptive import adaptive_kalman_filter
 from ..filters.imm import IMMResult, imm_filter
 from ..filters.kalman import kalman_filter
+from ._motion import simulate_turning
 from .helicopter import helicopter_model, helicopter_track, prediction_rms
 
 __all__ = [
@@ -65,18 +66,12 @@ def turn_rate_profile(t: np.ndarray) -> np.ndarray:
 
 def simulate_target(rng) -> tuple[np.ndarray, np.ndarray]:
     r"""Une trajectoire vraie :math:`[e, n, v_e, v_n]` (T, 4) et ses relevés radar (T, 2), tirés avec ``rng``
-    (virage coordonné exact, pas de bruit d'état : la manœuvre est la seule surprise)."""
+    (virage coordonné exact, pas de bruit d'état : la manœuvre est la seule surprise ;
+    :func:`~kalman_course.scenarios._motion.simulate_turning`)."""
     gen = np.random.default_rng(rng) if not isinstance(rng, np.random.Generator) else rng
     t = DT * np.arange(1, N_STEPS + 1)
-    w = turn_rate_profile(t - DT)  # la rotation du pas qui mène à t
-    x = np.array([0.0, 0.0, SPEED, 0.0, 0.0])
-    truth = np.empty((N_STEPS, 4))
-    for k in range(N_STEPS):
-        x[4] = w[k]
-        x = turn_transition(x, DT)
-        truth[k] = x[:4]
-    y = truth[:, :2] + POSITION_STD * gen.standard_normal((N_STEPS, 2))
-    return truth, y
+    truth, y = simulate_turning(turn_rate_profile(t - DT), [0.0, 0.0, SPEED, 0.0], DT, POSITION_STD, gen)
+    return truth[:, :4], y
 
 
 def cv_model(q: float) -> LinearGaussianModel:

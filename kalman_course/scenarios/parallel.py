@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..core.models import LinearGaussianModel
+from ..core.motion import constant_velocity
 from ..core.results import freeze_fields
 from ..core.simulation import as_generator, check_positive_int, simulate
 from ..filters.kalman import kalman_filter
@@ -54,9 +55,8 @@ PARALLEL_P0.setflags(write=False)
 def parallel_model(dt: float = PARALLEL_DT) -> LinearGaussianModel:
     r"""Vitesse constante dans le plan : état :math:`(p_x, p_y, v_x, v_y)`, mesure de la position
     (:math:`R = 0{,}01` m²), :math:`Q = 0{,}25\,GG^T` (accélération blanche)."""
-    A = np.array([[1, 0, dt, 0], [0, 1, 0, dt], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-    G = np.array([[dt**2 / 2, 0], [0, dt**2 / 2], [dt, 0], [0, dt]])
-    return LinearGaussianModel(A, np.eye(2, 4), 0.25 * G @ G.T, 0.01 * np.eye(2))
+    A, Q = constant_velocity(dt, accel_std=0.5)
+    return LinearGaussianModel(A, np.eye(2, 4), Q, 0.01 * np.eye(2))
 
 
 def parallel_data(n_steps: int, rng: Any = PARALLEL_SEED) -> np.ndarray:
@@ -99,7 +99,7 @@ def parallel_agreement(n_steps: int = 2000, rng: Any = PARALLEL_SEED) -> Agreeme
     par = parallel_kalman_filter(model, y, PARALLEL_X0, PARALLEL_P0)
     fields = ("x", "P", "x_pred", "P_pred", "K", "innovation", "S")
     smooth_seq = rts_smoother(model, seq, PARALLEL_X0, PARALLEL_P0)
-    smooth_par = parallel_rts_smoother(model, y, PARALLEL_X0, PARALLEL_P0)
+    smooth_par = parallel_rts_smoother(model, par, PARALLEL_X0, PARALLEL_P0)
     ll = filter_log_likelihood(seq)
     return Agreement(n_steps=n_steps, filter_gap=_gap(par, seq, fields),
                      smoother_gap=_gap(smooth_par, smooth_seq, ("x", "P", "G")), loglik=ll,

@@ -25,7 +25,8 @@ from ..core.models import NonlinearModel
 from ..core.results import freeze, freeze_fields
 from ..core.simulation import as_generator
 from ..tables import Table
-from ._motion import cv_process_noise, cv_transition, simulate_cv
+from ..core.motion import constant_velocity
+from ._motion import simulate_cv
 
 __all__ = [
     "radar_cost_grid",
@@ -251,11 +252,11 @@ def radar_tracking_model(
 ) -> NonlinearModel:
     r"""Cible à vitesse constante (état :math:`[p_x, p_y, v_x, v_y]`) vue par le radar (distance, azimut) ;
     modèle vectorisé (``f`` et ``h`` acceptent une pile d'états (N, 4))."""
-    F = cv_transition(dt)
+    F, Q = constant_velocity(dt, accel_std=accel_std)
     return NonlinearModel(
         f=lambda x, u: x.dot(F.T),  # un état (4,) ou une pile (N, 4)
         h=range_bearing,
-        Q=cv_process_noise(dt, accel_std),
+        Q=Q,
         R=np.diag([range_std**2, bearing_std**2]),
         f_jacobian=F,
         h_jacobian=lambda x: range_bearing_jacobian(x, 4),

@@ -24,6 +24,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..core.models import LinearGaussianModel
+from ..core.motion import constant_velocity
 from ..core.results import FilterResult, freeze_fields
 from ..core.simulation import simulate
 from ..filters.kalman import kalman_filter
@@ -65,8 +66,7 @@ TARGET_P0.setflags(write=False)
 def target_model(q: float = TARGET_Q, sigma: float = TARGET_SIGMA, dt: float = TARGET_DT) -> LinearGaussianModel:
     r"""Modèle à vitesse presque constante (voir le module) : :math:`A`, :math:`Q` d'une accélération
     blanche continue de densité ``q``, mesure de la position d'écart-type ``sigma``."""
-    A = np.array([[1.0, dt], [0.0, 1.0]])
-    Q = q * np.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]])
+    A, Q = constant_velocity(dt, q, dim=1)
     return LinearGaussianModel(A, [[1.0, 0.0]], Q, sigma**2)
 
 

@@ -29,7 +29,7 @@ from ..core.results import FilterResult, freeze_fields
 from ..core.simulation import as_generator
 from ..tables import Table
 from ..core.validation import KalmanInputError, as_float_array, shape_text
-from ._motion import cv_process_noise, cv_transition
+from ..core.motion import constant_velocity
 
 __all__ = [
     "TAG_ANCHORS",
@@ -126,11 +126,11 @@ def tag_model(
     A = np.array(anchors, dtype=float)
     if A.ndim != 2 or A.shape[1] != 2 or A.shape[0] < 1:
         raise KalmanInputError(f"« anchors » doit être de forme (N, 2) ; reçu {shape_text(A.shape)}.")
-    F = cv_transition(dt)
+    F, Q = constant_velocity(dt, accel_std=accel_std)
     return NonlinearModel(
         f=lambda x, u: x.dot(F.T),  # un état (4,) ou une pile (N, 4)
         h=lambda x: tag_ranges(x, A),
-        Q=cv_process_noise(dt, accel_std),
+        Q=Q,
         R=range_std**2 * np.eye(A.shape[0]),
         f_jacobian=F,
         h_jacobian=lambda x: tag_ranges_jacobian(x, A),

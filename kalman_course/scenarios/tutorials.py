@@ -19,10 +19,10 @@ et les tests (qui comparent les deux).
   parallèle, un pas du filtre d'information ;
 * :func:`exam_stationary`, :func:`exam_range_update`, :func:`exam_smoothing`, :func:`exam_tracking` — le
   sujet d'examen.
-* :func:`se2_by_hand` — TD 6 : une exponentielle et une adjointe de SE(2), puis une correction de l'EKF
+* :func:`se2_by_hand` — TD 7 : une exponentielle et une adjointe de SE(2), puis une correction de l'EKF
   invariant.
-* :func:`pda_by_hand` — TD 7 : une correction PDA scalaire avec deux détections ;
-* :func:`jpda_by_hand` — TD 7 : les probabilités JPDA de deux pistes et deux détections, par énumération.
+* :func:`pda_by_hand` — TD 8 : une correction PDA scalaire avec deux détections ;
+* :func:`jpda_by_hand` — TD 8 : les probabilités JPDA de deux pistes et deux détections, par énumération.
 """
 
 from __future__ import annotations
@@ -62,11 +62,11 @@ FOUR_U = 0.5
 ENSEMBLE_EXAMPLE = {"P_prior": 4.0, "R": 1.0, "members": 200_000, "seed": 5}
 #: TD 3 : marche aléatoire x_{k+1} = x_k + w_k, y_k = x_k + v_k, Q = R = 1, a priori N(0, 1), mesures.
 THREE_STEPS = {"Q": 1.0, "R": 1.0, "x0": 0.0, "P0": 1.0, "y": (1.0, 3.0, 2.0)}
-#: TD 7 : une piste scalaire (a priori 0, variance 3), R = 1, deux détections ; P_D, P_G et λ (par unité de
+#: TD 8 : une piste scalaire (a priori 0, variance 3), R = 1, deux détections ; P_D, P_G et λ (par unité de
 #: longueur).
 PDA_BY_HAND = {"x_prior": 0.0, "P_prior": 3.0, "R": 1.0, "detections": (1.0, -2.0), "P_D": 0.8, "P_G": 0.9,
                "lambda": 0.1}
-#: TD 7 : poids PDA (divisés par w₀) de deux pistes pour deux détections : colonne 0, aucune détection.
+#: TD 8 : poids PDA (divisés par w₀) de deux pistes pour deux détections : colonne 0, aucune détection.
 JPDA_WEIGHTS = np.array([[1.0, 4.0, 1.0], [1.0, 2.0, 3.0]])
 JPDA_WEIGHTS.setflags(write=False)
 
@@ -212,7 +212,7 @@ def parallel_elements() -> dict:
     model = LinearGaussianModel(1.0, 1.0, c["Q"], c["R"])
     y = np.array(c["y"])[:, None]
     elements = filtering_elements(model, y, np.array([c["x0"]]), np.array([[c["P0"]]]), None)
-    pick = lambda e, k: tuple(a[k:k + 1] for a in e)  # noqa: E731
+    pick = lambda e, k: tuple(a[..., k:k + 1] for a in e)  # noqa: E731 (éléments en colonnes : axe du pas en dernier)
     scalar = lambda e: tuple(float(np.asarray(a).reshape(-1)[0]) for a in e)  # noqa: E731
     a1, a2, a3 = (pick(elements, k) for k in range(3))
     a12 = combine_filtering(a1, a2)
@@ -300,7 +300,7 @@ def exam_tracking() -> dict:
             "nis": [nis_value(np.array(nu), S) for nu in c["nu"]], "cbar": cbar, "weights": W}
 
 
-#: TD 6 : le vecteur tangent ξ de l'exponentielle, la pose prédite T̂ (cap 90°, position (3, 1)), sa covariance
+#: TD 7 : le vecteur tangent ξ de l'exponentielle, la pose prédite T̂ (cap 90°, position (3, 1)), sa covariance
 #: P⁻ (erreur invariante à gauche ξ = [ρₓ, ρ_y, θ]), la position GNSS y et son écart-type σ.
 SE2_BY_HAND = {
     "xi": (1.0, 0.0, np.pi / 2),
@@ -313,7 +313,7 @@ SE2_BY_HAND = {
 
 @dataclass(frozen=True)
 class SE2ByHand:
-    """TD 6 : ``exp`` = Exp(ξ) (3, 3), ``adjoint`` = Ad de T̂ (3, 3), et la correction de l'EKF invariant
+    """TD 7 : ``exp`` = Exp(ξ) (3, 3), ``adjoint`` = Ad de T̂ (3, 3), et la correction de l'EKF invariant
     (:class:`~kalman_course.filters.invariant.SE2Update` : ``T``, ``P``, ``K``, ``innovation``, ``S``)."""
 
     exp: np.ndarray
@@ -322,7 +322,7 @@ class SE2ByHand:
 
 
 def se2_by_hand() -> SE2ByHand:
-    """Les calculs du TD 6 par le paquet : :func:`~kalman_course.se2_exp`, :func:`~kalman_course.se2_adjoint`
+    """Les calculs du TD 7 par le paquet : :func:`~kalman_course.se2_exp`, :func:`~kalman_course.se2_adjoint`
     et :func:`~kalman_course.filters.invariant.se2_invariant_update`."""
     from ..filters.invariant import se2_invariant_update
     from ..geometry.lie import se2_adjoint, se2_exp
@@ -332,11 +332,11 @@ def se2_by_hand() -> SE2ByHand:
                      se2_invariant_update(c["T_pred"], c["P_pred"], c["y"], c["gnss_std"]))
 
 
-# --------------------------------------------------------------------------- TD 7 : plusieurs cibles
+# --------------------------------------------------------------------------- TD 8 : plusieurs cibles
 
 
 def pda_by_hand() -> PDAUpdate:
-    """La correction PDA du TD 7 par :func:`kalman_course.pda_update` (modèle scalaire, C = 1)."""
+    """La correction PDA du TD 8 par :func:`kalman_course.pda_update` (modèle scalaire, C = 1)."""
     c = PDA_BY_HAND
     model = LinearGaussianModel(1.0, 1.0, 0.0, c["R"])
     return pda_update(model, [c["x_prior"]], [[c["P_prior"]]], np.array(c["detections"])[:, None],
@@ -344,6 +344,6 @@ def pda_by_hand() -> PDAUpdate:
 
 
 def jpda_by_hand() -> np.ndarray:
-    """Les probabilités JPDA (2, 3) du TD 7, par l'énumération du paquet
+    """Les probabilités JPDA (2, 3) du TD 8, par l'énumération du paquet
     (:func:`kalman_course.multitarget.jpda.joint_marginals`) sur les poids :data:`JPDA_WEIGHTS`."""
     return joint_marginals(np.array(JPDA_WEIGHTS), np.array(JPDA_WEIGHTS)[:, 1:] > 0)
