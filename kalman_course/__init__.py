@@ -151,6 +151,21 @@ from .geometry.lie import se2_adjoint, se2_exp, se2_left_jacobian, se2_log, se2_
 from .core.lorenz import lorenz63, lorenz96
 from .filters.ensemble_analysis import denkf_update, etkf_update, gaspari_cohn, letkf_update
 from .filters.variational import optimal_interpolation, three_dimensional_var, var3d_update
+# plusieurs cibles dans le fouillis : porte, association, gestion des pistes, GOSPA (issue 37)
+from .multitarget import (
+    GOSPA,
+    Gate,
+    MultiTargetResult,
+    PDAUpdate,
+    gnn_assign,
+    gospa,
+    jpda_probabilities,
+    multi_target_tracker,
+    nn_assign,
+    ospa,
+    pda_update,
+    validation_gate,
+)
 
 __all__ = [
     # modèles, résultats, erreurs
@@ -330,6 +345,19 @@ __all__ = [
     "var3d_update",
     "three_dimensional_var",
     "optimal_interpolation",
+    # plusieurs cibles dans le fouillis (issue 37)
+    "validation_gate",
+    "Gate",
+    "nn_assign",
+    "gnn_assign",
+    "pda_update",
+    "PDAUpdate",
+    "jpda_probabilities",
+    "gospa",
+    "GOSPA",
+    "ospa",
+    "multi_target_tracker",
+    "MultiTargetResult",
     # sous-modules
     "errata",
     "geometry",

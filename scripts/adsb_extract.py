@@ -2,7 +2,8 @@
 
 Deux vols des données d'exemple de la bibliothèque traffic (X. Olive, licence MIT ; données de The OpenSky
 Network) : l'hélicoptère SAMU 31 au-dessus de Toulouse (``ambulances/samu31.json.gz``) et le vol de
-calibration de Toulouse (``calibration/toulouse.json.gz``). traffic n'est **pas** une dépendance du cours
+calibration de Toulouse (``calibration/toulouse.json.gz``) ; et le trafic de cinq vols autour de
+Toulouse-Blagnac (:data:`TRAFFIC`, fenêtres de 5 min, dans ``toulouse_traffic.csv.gz``). traffic n'est **pas** une dépendance du cours
 (il tire onnxruntime, pyarrow…) : on lit ses fichiers JSON compressés directement dans la roue, sans
 l'installer ni l'importer.
 
@@ -50,6 +51,36 @@ FLIGHTS = {
 }
 
 
+#: Le trafic autour de Toulouse-Blagnac (partie « Plusieurs cibles ») : cinq vols des mêmes exemples de traffic,
+#: chacun pris sur une fenêtre de ``TRAFFIC_WINDOW_S`` secondes (plus ``TRAFFIC_MARGIN_S`` de part et d'autre,
+#: pour interpoler aux bords). Ces vols ont eu lieu des jours différents : la scène les **rejoue sur une
+#: horloge commune** (l'instant 0 de chacun est le début de sa fenêtre). Les débuts de fenêtre ont été choisis
+#: pour que les trajectoires, toutes dans un rectangle de 22 km sur 14 km au sud-est de l'aérodrome, se croisent
+#: (croisements à moins de 500 m au même instant). Indicatif → (fichier dans la roue, début de la fenêtre en ms
+#: UTC, description).
+TRAFFIC_WINDOW_S = 300
+TRAFFIC_MARGIN_S = 10
+TRAFFIC = {
+    "SAMU31": ("traffic/data/samples/ambulances/samu31.json.gz", 1558092215000,
+               "Hélicoptère SAMU 31 (icao24 39ac45), 17 mai 2019"),
+    "PXR31F": ("traffic/data/samples/surveys/pixair_toulouse.json.gz", 1554028344000,
+               "Avion de prise de vues aériennes Pixair (icao24 39b861), lignes de relevé au-dessus de Toulouse, "
+               "31 mars 2019"),
+    "CALIBRA": ("traffic/data/samples/calibration/toulouse.json.gz", 1497602210000,
+                "Vol de calibration (icao24 39b415), 16 juin 2017"),
+    "SAVAN03": ("traffic/data/samples/collections/savan.json.gz", 1647935011000,
+                "Vol de calibration SAVAN03 (icao24 39b415), départ de Blagnac, 22 mars 2022"),
+    "SAVAN11": ("traffic/data/samples/collections/savan.json.gz", 1648449558000,
+                "Vol de calibration SAVAN11 (icao24 39b415), départ de Blagnac, 28 mars 2022"),
+}
+#: Colonnes gardées pour le trafic (``last_position`` : vide dans les fichiers qui ne l'ont pas).
+TRAFFIC_COLUMNS = {"timestamp": "timestamp_ms", "last_position": "last_position_ms", "latitude": "latitude_deg",
+                   "longitude": "longitude_deg", "altitude": "altitude_ft", "groundspeed": "groundspeed_kt",
+                   "track": "track_deg"}
+#: Origine du plan tangent commun : l'aérodrome de Toulouse-Blagnac (coordonnées arrondies).
+TRAFFIC_ORIGIN = {"name": "Toulouse-Blagnac (LFBO)", "latitude_deg": 43.6289, "longitude_deg": 1.3636}
+
+
 def sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
@@ -72,6 +103,42 @@ def extract_csv(raw_gz: bytes, columns: dict[str, str]) -> str:
     for r in rows:
         lines.append(",".join(_value(r.get(key)) for key in columns))
     return "\n".join(lines) + "\n"
+
+
+def extract_traffic(zf: zipfile.ZipFile) -> tuple[str, dict]:
+    """Le CSV du trafic (colonne ``aircraft`` : rang du vol dans :data:`TRAFFIC`, puis :data:`TRAFFIC_COLUMNS`) et
+    sa provenance, vol par vol : fichier d'origine, SHA-256, fenêtre, nombre de lignes."""
+    lines = [",".join(["aircraft", *TRAFFIC_COLUMNS.values()])]
+    aircraft = []
+    for rank, (callsign, (member, start_ms, description)) in enumerate(TRAFFIC.items()):
+        raw = zf.read(member)
+        rows = json.loads(gzip.decompress(raw))
+        lo, hi = start_ms - 1000 * TRAFFIC_MARGIN_S, start_ms + 1000 * (TRAFFIC_WINDOW_S + TRAFFIC_MARGIN_S)
+        kept = sorted((r for r in rows if r.get("callsign") == callsign and lo <= r["timestamp"] <= hi),
+                      key=lambda r: r["timestamp"])
+        if not kept:
+            raise ValueError(f"aucune ligne de {callsign} dans {member} entre {lo} et {hi} ms")
+        for r in kept:
+            lines.append(",".join([str(rank)] + [_value(r.get(key)) for key in TRAFFIC_COLUMNS]))
+        aircraft.append({
+            "callsign": callsign,
+            "icao24": kept[0].get("icao24"),
+            "description": description,
+            "source_file": member,
+            "source_sha256": sha256(raw),
+            "window_start_ms": start_ms,
+            "rows": len(kept),
+        })
+    info = {
+        "description": "Cinq vols autour de Toulouse-Blagnac, enregistrés des jours différents et rejoués sur une "
+                       "horloge commune (instant 0 : début de la fenêtre de chaque vol)",
+        "window_s": TRAFFIC_WINDOW_S,
+        "margin_s": TRAFFIC_MARGIN_S,
+        "origin": TRAFFIC_ORIGIN,
+        "columns": ["aircraft", *TRAFFIC_COLUMNS.values()],
+        "aircraft": aircraft,
+    }
+    return "\n".join(lines) + "\n", info
 
 
 def extract(wheel: Path, out: Path = OUT) -> dict:
@@ -106,6 +173,11 @@ def extract(wheel: Path, out: Path = OUT) -> dict:
                 "extract": f"{name}.csv.gz",
                 "extract_sha256": sha256(data),
             }
+        text, info = extract_traffic(zf)
+        data = text.encode("utf-8")
+        (out / "toulouse_traffic.csv.gz").write_bytes(gzip.compress(data, compresslevel=9, mtime=0))
+        provenance["traffic"] = {**info, "rows": text.count("\n") - 1, "extract": "toulouse_traffic.csv.gz",
+                                 "extract_sha256": sha256(data)}
     (out / "adsb.json").write_text(json.dumps(provenance, ensure_ascii=False, indent=2) + "\n", encoding="utf-8")
     return provenance
 
@@ -118,6 +190,8 @@ def main(argv: list[str] | None = None) -> None:
     prov = extract(args.wheel, args.out)
     for name, info in prov["flights"].items():
         print(f"{name} : {info['rows']} lignes de {info['source_file']} (SHA-256 {info['source_sha256'][:16]}…)")
+    traffic = prov["traffic"]
+    print(f"trafic de Toulouse-Blagnac : {traffic['rows']} lignes de {len(traffic['aircraft'])} vols")
     print(f"provenance : {args.out / 'adsb.json'}")
 
 

@@ -105,18 +105,33 @@ def test_reported_velocity_agrees_with_the_positions(loader):
 
 
 def _fake_wheel(path: Path, version="9.9") -> Path:
+    """Une roue de traffic factice : les fichiers des vols et du trafic, quelques lignes chacun (les lignes de
+    l'hélicoptère tombent dans sa fenêtre du trafic ; une ligne d'un autre indicatif, ou hors fenêtre, est
+    écartée du trafic)."""
+    traffic = _script().TRAFFIC
+    t0 = traffic["SAMU31"][1]
     rows_samu = [
-        {"timestamp": 2000, "last_position": 1900, "latitude": 43.6, "longitude": 1.4, "altitude": 1000.0,
-         "groundspeed": 80.5, "track": 90.0, "callsign": "X"},
-        {"timestamp": 1000, "last_position": 900, "latitude": 43.59, "longitude": 1.39, "altitude": 975.0,
-         "groundspeed": 80, "track": 89.5, "callsign": "X"},
+        {"timestamp": t0 + 2000, "last_position": t0 + 1900, "latitude": 43.6, "longitude": 1.4, "altitude": 1000.0,
+         "groundspeed": 80.5, "track": 90.0, "callsign": "SAMU31", "icao24": "39ac45"},
+        {"timestamp": t0 + 1000, "last_position": t0 + 900, "latitude": 43.59, "longitude": 1.39, "altitude": 975.0,
+         "groundspeed": 80, "track": 89.5, "callsign": "SAMU31", "icao24": "39ac45"},
     ]
-    rows_cal = [{"timestamp": 5000 * i, "latitude": 43.0 + i * 1e-3, "longitude": 1.0, "altitude": 100,
-                 "groundspeed": 100, "track": 0} for i in range(3)]
+    members = {"traffic/data/samples/ambulances/samu31.json.gz": rows_samu,
+               "traffic/data/samples/calibration/toulouse.json.gz": []}
+    for callsign, (member, start, _) in traffic.items():
+        if callsign != "SAMU31":
+            members.setdefault(member, []).extend([
+                {"timestamp": start + 5000 * i, "latitude": 43.5, "longitude": 1.5, "altitude": 100, "groundspeed": 100,
+                 "track": 0, "callsign": callsign} for i in range(3)])
+            members[member].append({"timestamp": start - 60_000, "latitude": 43.5, "longitude": 1.5, "altitude": 100,
+                                    "groundspeed": 100, "track": 0, "callsign": callsign})  # hors fenêtre
+    members["traffic/data/samples/calibration/toulouse.json.gz"].append(
+        {"timestamp": 1, "latitude": 43.0, "longitude": 1.0, "altitude": 100, "groundspeed": 100, "track": 0,
+         "callsign": "AUTRE"})
     wheel = path / f"traffic-{version}-py3-none-any.whl"
     with zipfile.ZipFile(wheel, "w") as zf:
-        zf.writestr("traffic/data/samples/ambulances/samu31.json.gz", gzip.compress(json.dumps(rows_samu).encode(), mtime=0))
-        zf.writestr("traffic/data/samples/calibration/toulouse.json.gz", gzip.compress(json.dumps(rows_cal).encode(), mtime=0))
+        for member, rows in members.items():
+            zf.writestr(member, gzip.compress(json.dumps(rows).encode(), mtime=0))
     return wheel
 
 
@@ -131,12 +146,21 @@ def test_extract_script_rebuilds_the_extract_from_a_wheel(tmp_path):
         raw = zf.read("traffic/data/samples/ambulances/samu31.json.gz")
     info = prov["flights"]["samu31"]
     assert info["source_sha256"] == hashlib.sha256(raw).hexdigest() and info["rows"] == 2
+    t0 = script.TRAFFIC["SAMU31"][1]
     text = gzip.decompress((out / "samu31.csv.gz").read_bytes()).decode()
     assert text.splitlines() == [
         "timestamp_ms,last_position_ms,latitude_deg,longitude_deg,altitude_ft,groundspeed_kt,track_deg",
-        "1000,900,43.59,1.39,975.0,80,89.5",      # trié par temps, valeurs recopiées telles quelles
-        "2000,1900,43.6,1.4,1000.0,80.5,90.0",
+        f"{t0 + 1000},{t0 + 900},43.59,1.39,975.0,80,89.5",      # trié par temps, valeurs recopiées telles quelles
+        f"{t0 + 2000},{t0 + 1900},43.6,1.4,1000.0,80.5,90.0",
     ]
+    # le trafic : les lignes de chaque indicatif dans sa fenêtre, rang du vol en tête
+    traffic = prov["traffic"]
+    assert [a["callsign"] for a in traffic["aircraft"]] == list(script.TRAFFIC)
+    assert [a["rows"] for a in traffic["aircraft"]] == [2, 3, 3, 3, 3] and traffic["rows"] == 14
+    lines = gzip.decompress((out / traffic["extract"]).read_bytes()).decode().splitlines()
+    assert lines[0] == "aircraft,timestamp_ms,last_position_ms,latitude_deg,longitude_deg,altitude_ft,groundspeed_kt,track_deg"
+    assert lines[1] == f"0,{t0 + 1000},{t0 + 900},43.59,1.39,975.0,80,89.5"
+    assert lines[3].startswith(f"1,{script.TRAFFIC['PXR31F'][1]},,43.5,1.5,")  # sans last_position : vide
     first = {p.name: p.read_bytes() for p in out.iterdir()}
     script.extract(wheel, out)
     assert {p.name: p.read_bytes() for p in out.iterdir()} == first  # mêmes octets à chaque régénération
@@ -148,5 +172,55 @@ def test_shipped_extract_is_what_the_script_writes_from_the_real_wheel(tmp_path)
     l'identique."""
     prov = _script().extract(Path(os.environ["TRAFFIC_WHEEL"]), tmp_path)
     assert prov == adsb.provenance()
-    for info in prov["flights"].values():
+    for info in [*prov["flights"].values(), prov["traffic"]]:
         assert (tmp_path / info["extract"]).read_bytes() == (adsb.DATA / info["extract"]).read_bytes()
+
+
+# --------------------------------------------------------------------------- trafic de Toulouse-Blagnac (issue 37)
+
+
+def test_toulouse_traffic_replays_five_flights_on_a_common_clock():
+    traffic = kc.datasets.toulouse_traffic()
+    prov = adsb.provenance()["traffic"]
+    assert traffic.names == ("SAMU31", "PXR31F", "CALIBRA", "SAVAN03", "SAVAN11")
+    assert traffic.window == 300.0 and len({f.start_utc[:10] for f in traffic.flights}) == 5  # cinq jours
+    data = gzip.decompress((adsb.DATA / prov["extract"]).read_bytes())
+    assert hashlib.sha256(data).hexdigest() == prov["extract_sha256"] and data.decode().count("\n") - 1 == prov["rows"]
+    assert (adsb.DATA / prov["extract"]).stat().st_size < 40_000
+    for f, plane in zip(traffic.flights, prov["aircraft"]):
+        # l'instant 0 de chaque vol est le début de sa fenêtre ; les positions la couvrent (marge de 10 s)
+        assert f.t[0] <= 0.0 < 300.0 <= f.t[-1] and np.all(np.diff(f.t) > 0)
+        assert f.start_utc == adsb._utc(plane["window_start_ms"])
+        assert np.diff(f.t).max() <= 13.0 + 1e-9  # au plus 13 s entre deux positions (Pixair : 8 s en médiane)
+
+
+def test_toulouse_traffic_shares_the_tangent_plane_at_blagnac():
+    traffic = kc.datasets.toulouse_traffic()
+    prov = adsb.provenance()["traffic"]
+    header, table = adsb._read_extract(prov)
+    col = {h: table[:, i] for i, h in enumerate(header)}
+    lat0, lon0 = traffic.origin
+    for rank, f in enumerate(traffic.flights):
+        rows = col["aircraft"] == rank
+        time = col["last_position_ms"][rows] if np.isfinite(col["last_position_ms"][rows]).all() else col["timestamp_ms"][rows]
+        first = np.unique(time, return_index=True)[1]
+        e, n, _ = pymap3d.geodetic2enu(col["latitude_deg"][rows][first], col["longitude_deg"][rows][first], 0.0,
+                                       lat0, lon0, 0.0)
+        assert np.max(np.abs(f.east - e)) < 1e-6 and np.max(np.abs(f.north - n)) < 1e-6
+
+
+def test_toulouse_traffic_tracks_cross_in_a_small_region():
+    """Les cinq trajectoires tiennent dans un rectangle de 25 km sur 15 km autour de l'aérodrome et se croisent :
+    plusieurs paires passent à moins de 500 m l'une de l'autre au même instant de l'horloge commune."""
+    traffic = kc.datasets.toulouse_traffic()
+    t = np.arange(0.0, 300.0 + 1e-9, 1.0)
+    p = traffic.positions(t)
+    assert p.shape == (t.size, 5, 2)
+    assert np.ptp(p[..., 0]) < 25e3 and np.ptp(p[..., 1]) < 15e3
+    close = [(i, j) for i in range(5) for j in range(i + 1, 5) if np.linalg.norm(p[:, i] - p[:, j], axis=1).min() < 500.0]
+    assert len(close) >= 4
+    f = traffic.flights[0]
+    k = np.searchsorted(f.t, 100.0)
+    w = (100.0 - f.t[k - 1]) / (f.t[k] - f.t[k - 1])  # interpolation linéaire entre deux positions
+    np.testing.assert_allclose(traffic.positions([100.0])[0, 0], [(1 - w) * f.east[k - 1] + w * f.east[k],
+                                                                  (1 - w) * f.north[k - 1] + w * f.north[k]])

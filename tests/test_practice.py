@@ -24,6 +24,9 @@ import urllib.request
 from fractions import Fraction
 from pathlib import Path
 
+import itertools
+import math
+
 import numpy as np
 import pytest
 import scipy
@@ -1004,8 +1007,11 @@ def test_hidden_cases_include_the_smallest_size_and_a_larger_one():
     for ex in EXERCISES:
         if ex.id in FIXED_SIZES:
             continue
-        sizes = [min(min(a.shape) for a in c.args if isinstance(a, np.ndarray) and a.ndim >= 1) for c in ex.cases()]
-        largest = [max(max(a.shape) for a in c.args if isinstance(a, np.ndarray) and a.ndim >= 1) for c in ex.cases()]
+        # (un tableau vide — un relevé sans détection — n'est pas une taille)
+        sizes = [min(min(a.shape) for a in c.args if isinstance(a, np.ndarray) and a.ndim >= 1 and a.size)
+                 for c in ex.cases()]
+        largest = [max(max(a.shape) for a in c.args if isinstance(a, np.ndarray) and a.ndim >= 1 and a.size)
+                   for c in ex.cases()]
         assert min(sizes) == 1 and max(largest) >= 3, (ex.id, sizes, largest)
 
 
@@ -1341,3 +1347,163 @@ def test_etkf_lab_with_the_page_solutions_equals_the_package_and_reports_failure
     wrong = practice.exercise("etkf-update").mistakes[0].example  # racine de Cholesky : la moyenne glisse
     run = kc.scenarios.assimilation.etkf_lab(wrong)
     assert run.message is None and np.abs(run.student["rmse"] - run.reference["rmse"]).max() > 1e-3
+
+
+# --------------------------------------------------------------------------- plusieurs cibles (issue 37)
+
+
+def test_tutorial_eight_answers_are_the_package_values():
+    text = _page("td-plusieurs-cibles")
+    step = kc.scenarios.tutorials.pda_by_hand()
+    gate = kc.validation_gate(kc.LinearGaussianModel(1.0, 1.0, 0.0, 1.0), [[0.0]], [[[3.0]]], [[1.0], [-2.0]],
+                              gate_probability=0.9)
+    assert "$2\\sqrt{\\gamma S} =\n   2\\sqrt{2{,}706 \\times 4} = 6{,}58$" in text
+    assert gate.volume[0] == pytest.approx(6.58, abs=5e-3) and 0.1 * gate.volume[0] == pytest.approx(0.658, abs=5e-4)
+    assert gate.threshold == pytest.approx(2.706, abs=5e-4) and list(gate.nis[0]) == [0.25, 1.0]
+    assert "$\\beta = (0{,}105 ;\\ 0{,}530 ;\\ 0{,}364)$" in text
+    np.testing.assert_allclose(step.weights, [0.105, 0.530, 0.364], atol=5e-4)
+    assert "$\\hat x = 0 + 0{,}75 \\times (-0{,}199) = -0{,}149$" in text and step.x[0] == pytest.approx(-0.149, abs=5e-4)
+    assert "= 2{,}083$" in text and step.P[0, 0] == pytest.approx(2.083, abs=5e-4)
+    # les nombres intermédiaires : densités, poids, dispersion, variance sans dispersion (quiz)
+    dens = scipy.stats.norm(0.0, 2.0).pdf([1.0, -2.0])
+    assert "= 0{,}1760$" in text and "0{,}1210$" in text
+    np.testing.assert_allclose(dens, [0.1760, 0.1210], atol=5e-5)
+    b = step.weights
+    nu_bar = b[1] * 1.0 + b[2] * -2.0
+    assert "$K^2 \\times 1{,}948 = 1{,}096$" in text
+    assert b[1] + 4 * b[2] - nu_bar**2 == pytest.approx(1.948, abs=5e-4)
+    assert 0.5625 * (b[1] + 4 * b[2] - nu_bar**2) == pytest.approx(1.096, abs=5e-4)
+    assert "$0{,}987$ au lieu de $2{,}083$" in text
+    assert b[0] * 3 + (1 - b[0]) * 0.75 == pytest.approx(0.987, abs=5e-4)
+    # JPDA : le paquet, une énumération écrite ici, et les fractions du texte
+    beta = kc.scenarios.tutorials.jpda_by_hand()
+    w = np.array(kc.scenarios.tutorials.JPDA_WEIGHTS)
+    manual = np.zeros_like(w)
+    for a, c in itertools.product(range(3), repeat=2):
+        if a == 0 or a != c:
+            manual[0, a] += w[0, a] * w[1, c]
+            manual[1, c] += w[0, a] * w[1, c]
+    np.testing.assert_allclose(beta, manual / manual.sum(axis=1, keepdims=True), rtol=1e-14)
+    np.testing.assert_allclose(beta, [[0.24, 0.64, 0.12], [0.24, 0.16, 0.60]], atol=1e-14)
+    assert "Total : $25$" in text and "$(4 + 12)/25 = 0{,}64$" in text and "$(3 + 12)/25 = 0{,}60$" in text
+    assert "pour $k = 3$ : $1 + 9 + 18 + 6 = 34$" in text
+    assert sum(math.comb(3, i) ** 2 * math.factorial(i) for i in range(4)) == 34
+
+
+def test_stonesoup_pda_passes_the_checker():
+    """Une implémentation indépendante (les poids et la correction de Stone Soup, ``PDAHypothesiser`` et
+    ``PDAUpdater``) passe le correcteur : ses cas cachés ne dépendent pas des conventions du paquet."""
+    pytest.importorskip("stonesoup")
+    import datetime
+
+    from stonesoup.hypothesiser.probability import PDAHypothesiser
+    from stonesoup.models.measurement.linear import LinearGaussian
+    from stonesoup.predictor.kalman import KalmanPredictor
+    from stonesoup.types.detection import Detection
+    from stonesoup.types.hypothesis import SingleProbabilityHypothesis
+    from stonesoup.types.multihypothesis import MultipleHypothesis
+    from stonesoup.types.state import GaussianState
+    from stonesoup.types.track import Track
+    from stonesoup.updater.kalman import KalmanUpdater
+    from stonesoup.updater.probability import PDAUpdater
+    from stonesoup.models.transition.linear import RandomWalk, CombinedLinearGaussianTransitionModel
+
+    t0 = datetime.datetime(2024, 1, 1)
+
+    def parts(n, C, R):
+        mm = LinearGaussian(ndim_state=n, mapping=tuple(range(n)), noise_covar=np.asarray(R))
+        mm.matrix = lambda **kw: np.asarray(C)  # une matrice d'observation quelconque
+        predictor = KalmanPredictor(CombinedLinearGaussianTransitionModel([RandomWalk(0.0)] * n))
+        return mm, predictor, KalmanUpdater(mm)
+
+    def ss_weights(innovations, S, detection_probability, clutter_density, gate_probability):
+        m = S.shape[0]
+        mm, predictor, updater = parts(m, np.eye(m), S)
+        track = Track([GaussianState(np.zeros((m, 1)), np.zeros((m, m)), timestamp=t0)])
+        dets = [Detection(nu[:, None], timestamp=t0, measurement_model=mm) for nu in innovations]
+        hyps = PDAHypothesiser(predictor, updater, clutter_spatial_density=clutter_density,
+                               prob_detect=detection_probability, prob_gate=gate_probability).hypothesise(
+            track, set(dets), t0)
+        beta = np.zeros(len(dets) + 1)
+        for h in hyps:
+            beta[0 if not h else 1 + next(j for j, d in enumerate(dets) if d is h.measurement)] = float(h.probability)
+        return beta
+
+    def ss_update(x_pred, P_pred, detections, C, R, beta):
+        n = x_pred.shape[0]
+        mm, predictor, updater = parts(n, C, R)
+        prediction = predictor.predict(Track([GaussianState(x_pred[:, None], P_pred, timestamp=t0)]), timestamp=t0)
+        hyps = [SingleProbabilityHypothesis(prediction, __import__("stonesoup.types.detection", fromlist=["x"])
+                                            .MissedDetection(timestamp=t0), beta[0])]
+        for z, b in zip(detections, beta[1:]):
+            det = Detection(z[:, None], timestamp=t0, measurement_model=mm)
+            hyps.append(SingleProbabilityHypothesis(prediction, det, b, updater.predict_measurement(prediction, mm)))
+        upd = PDAUpdater(mm).update(MultipleHypothesis(hyps, normalise=False))
+        return np.asarray(upd.state_vector, float).ravel(), np.asarray(upd.covar, float)
+
+    for exercise_id, fn in (("pda-weights", ss_weights), ("pda-update", ss_update)):
+        verdict = practice.check(exercise_id, fn)
+        assert verdict.passed, verdict.feedback
+
+
+PDA_STUDENT_MISTAKES = [
+    ("pda-weights", "no-missed", "beta = w / w.sum()", """\
+def pda_weights(innovations, S, detection_probability, clutter_density, gate_probability):
+    m = S.shape[0]
+    nis = np.sum(innovations * np.linalg.solve(S, innovations.T).T, axis=1)
+    dens = np.exp(-nis / 2) / np.sqrt((2 * np.pi) ** m * np.linalg.det(S))
+    w = np.where(nis <= scipy.stats.chi2.ppf(gate_probability, m), detection_probability * dens / clutter_density, 0)
+    beta = w / w.sum()
+    return beta
+"""),
+    ("pda-weights", "not-normalised", "return np.concatenate([[1 - detection_probability * gate_probability], w])", """\
+def pda_weights(innovations, S, detection_probability, clutter_density, gate_probability):
+    m = S.shape[0]
+    nis = np.sum(innovations * np.linalg.solve(S, innovations.T).T, axis=1)
+    dens = np.exp(-nis / 2) / np.sqrt((2 * np.pi) ** m * np.linalg.det(S))
+    w = np.where(nis <= scipy.stats.chi2.ppf(gate_probability, m), detection_probability * dens / clutter_density, 0)
+    return np.concatenate([[1 - detection_probability * gate_probability], w])
+"""),
+    ("pda-weights", "swapped", "w = np.where(nis <= scipy.stats.chi2.ppf(gate_probability, m), clutter_density * dens / detection_probability, 0)", """\
+def pda_weights(innovations, S, detection_probability, clutter_density, gate_probability):
+    m = S.shape[0]
+    nis = np.sum(innovations * np.linalg.solve(S, innovations.T).T, axis=1)
+    dens = np.exp(-nis / 2) / np.sqrt((2 * np.pi) ** m * np.linalg.det(S))
+    w = np.where(nis <= scipy.stats.chi2.ppf(gate_probability, m), clutter_density * dens / detection_probability, 0)
+    w = np.concatenate([[1 - detection_probability * gate_probability], w])
+    return w / w.sum()
+"""),
+    ("pda-update", "no-spread", "P = beta[0] * P_pred + (1 - beta[0]) * (P_pred - K @ S @ K.T)", """\
+def pda_update(x_pred, P_pred, detections, C, R, beta):
+    S = C @ P_pred @ C.T + R
+    K = np.linalg.solve(S, C @ P_pred).T
+    nu_bar = beta[1:] @ (detections - C @ x_pred)
+    P = beta[0] * P_pred + (1 - beta[0]) * (P_pred - K @ S @ K.T)
+    return x_pred + K @ nu_bar, P
+"""),
+]
+
+
+@pytest.mark.parametrize("exercise_id, mistake_id, line, source", PDA_STUDENT_MISTAKES,
+                         ids=[f"{e}-{m}" for e, m, _, _ in PDA_STUDENT_MISTAKES])
+def test_pda_mistakes_written_by_hand_are_recognised(exercise_id, mistake_id, line, source):
+    name = re.match(r"def (\w+)", source).group(1)
+    verdict = practice.check(exercise_id, cell(source, name))
+    assert not verdict.passed and verdict.mistake == mistake_id, verdict.feedback
+    if line:
+        number = next(i for i, text in enumerate(source.splitlines(), 1) if text.strip() == line)
+        assert verdict.line == number, verdict.feedback
+
+
+def test_pda_hidden_cases_cover_every_regime():
+    labels = {ex.id: " ".join(c.label for c in ex.cases()) for ex in EXERCISES if ex.id.startswith("pda-")}
+    weights, update = labels["pda-weights"], labels["pda-update"]
+    for regime in ("N = 0", "hors de la fenêtre", "aucune détection dans la fenêtre", "P_D = 1", "m = 1", "m = 3",
+                   "fouillis dense"):
+        assert regime in weights, regime
+    for regime in ("N = 0", "hors de la fenêtre", "β = (0, 1)", "β₀ grand", "C pleine"):
+        assert regime in update, regime
+    cases = practice.exercise("pda-weights").cases()
+    outside = next(c for c in cases if c.label == "aucune détection dans la fenêtre")
+    np.testing.assert_array_equal(outside.expected[0], [1.0, 0.0, 0.0])  # la prédiction seule
+

@@ -1405,6 +1405,108 @@ def _var_one_in_eight():
     assert _density(8)["letkf"] > 1.0
 
 
+# =========================================================================== plusieurs cibles (issue 37)
+
+
+def _traffic():
+    from kalman_course.scenarios import traffic as tr
+
+    return tr, tr.truth_names()
+
+
+def _summary(run) -> dict[str, float]:
+    """La lecture sous les curseurs : GOSPA moyenne, ses composantes, pistes, changements d'identité."""
+    keys = ("gospa", "localisation", "missed", "false", "tracks", "changes")
+    return dict(zip(keys, run["summary"]))
+
+
+def _false_points(run) -> int:
+    return int(np.isfinite(run["false_e"]).sum())
+
+
+@promise("fouillis-association", 1, 1)
+def _association_clutter_spawns_false_tracks():
+    low, high = at("association-curseurs", clutter=3e-8), at("association-curseurs", clutter=1e-7)
+    assert _false_points(low) == 0 and np.all(low["false"] == 0)
+    assert _false_points(high) > 0 and _summary(high)["false"] > 0  # des points noirs, une composante
+    assert np.all(high["gospa"] + 1e-9 >= high["false"])  # (la composante est dans la GOSPA)
+    for name in ("gospa", "localisation", "missed", "false"):  # la lecture est celle des courbes
+        assert _summary(high)[name] == pytest.approx(np.mean(high[name]))
+
+
+@promise("fouillis-association", 1, 2)
+def _association_pda_in_dense_clutter():
+    jpda, pda = at("association-curseurs", clutter=1e-7), at("association-curseurs", clutter=1e-7, method=2)
+    assert _summary(pda)["gospa"] > 1.5 * _summary(jpda)["gospa"]  # de plus de moitié
+    assert _summary(pda)["changes"] >= 1 and _summary(jpda)["changes"] == 0  # des pistes changent d'avion
+
+
+@promise("fouillis-association", 1, 3)
+def _association_low_detection_probability():
+    base, low = at("association-curseurs"), at("association-curseurs", pd=0.6)
+    assert _summary(base)["tracks"] == 5 and _summary(low)["tracks"] > 5  # des pistes renaissent
+    tr, _ = _traffic()
+    segments = 0
+    for a in range(5):  # plusieurs tronçons d'une même couleur (lignes de K relevés, séparées par NaN)
+        alive = np.isfinite(low[f"a{a}_e"].reshape(tr.TRACK_SLOTS, tr.N_SCANS + 1)[:, :-1]).any(axis=0)
+        segments = max(segments, int(np.sum(np.diff(alive.astype(int)) == 1)) + int(alive[0]))
+    assert segments >= 2
+    assert _summary(low)["missed"] > 2 * _summary(base)["missed"]  # la composante grandit
+
+
+@promise("fouillis-association", 1, 4)
+def _association_nearest_neighbour_loses_calibra():
+    tr, names = _traffic()
+    nn, jpda = at("association-curseurs", method=0), at("association-curseurs")
+    assert _summary(nn)["changes"] == 1 and _summary(jpda)["changes"] == 0
+    run = tr.track_scene("nn")  # la même exécution que la figure
+    calibra = run.labels[:, names.index("CALIBRA")]
+    k = 3 + int(np.flatnonzero(calibra[3:] != calibra[3])[0])  # CALIBRA perd sa piste…
+    assert 130.0 <= tr.DT * k <= 150.0  # … vers t = 140 s, à sa rencontre avec SAVAN03
+    savan03 = tr.truth()[:, names.index("SAVAN03")]
+    gap = np.linalg.norm(tr.truth()[:, names.index("CALIBRA")] - savan03, axis=1)
+    assert gap[k - 2: k + 1].min() < 300.0
+    assert _summary(nn)["gospa"] > _summary(jpda)["gospa"]
+
+
+@promise("gestion-pistes", 1, 1)
+def _management_confirmation_rules_against_false_tracks():
+    runs = [at("pistes-curseurs", clutter=1e-7, confirm=c) for c in (0.0, 1.0, 2.0)]
+    false = [_summary(r)["false"] for r in runs]
+    points = [_false_points(r) for r in runs]
+    assert false[0] > false[1] > false[2] == 0.0 and points[0] > points[1] > points[2] == 0
+    assert _summary(runs[0])["tracks"] - 5 >= 20  # des dizaines de fausses pistes en 3 sur 4
+
+
+@promise("gestion-pistes", 1, 2)
+def _management_confirmation_delay():
+    runs = [at("pistes-curseurs", clutter=1e-7, confirm=c) for c in (0.0, 1.0, 2.0)]
+    first = [int(np.flatnonzero(r["missed"] < 5 * 500.0 - 1e-9)[0]) for r in runs]  # premier avion confirmé
+    assert first[0] < first[1] < first[2]
+    early = [r["missed"][:8].sum() for r in runs]
+    assert early[0] < early[1] < early[2]
+
+
+@promise("gestion-pistes", 1, 3)
+def _management_narrow_gate_loses_calibra():
+    tr, names = _traffic()
+    narrow, base = at("pistes-curseurs", gate=0.9, clutter=3e-8), at("pistes-curseurs", clutter=3e-8)
+    assert _summary(base)["changes"] == 0 and _summary(base)["tracks"] == 5
+    assert _summary(narrow)["changes"] == 1 and _summary(narrow)["tracks"] == 6
+    run = tr.track_scene("jpda", tr.DETECTION_PROBABILITY, 3e-8, 0.9, (4, 5))
+    calibra = run.labels[:, names.index("CALIBRA")]
+    k = 3 + int(np.flatnonzero(calibra[3:] != calibra[3])[0])
+    assert 125.0 <= tr.DT * k <= 145.0  # vers t = 135 s
+    assert np.all(calibra[k:k + 3] == -1)  # trois relevés sans piste, puis un autre numéro
+    assert calibra[-1] not in (-1, calibra[3])
+
+
+@promise("gestion-pistes", 1, 4)
+def _management_wider_gate_more_false_tracks():
+    narrow, wide = at("pistes-curseurs", gate=0.9, clutter=1e-7), at("pistes-curseurs", gate=0.99, clutter=1e-7)
+    assert _summary(wide)["false"] > 2 * _summary(narrow)["false"] > 0
+
+
 # --------------------------------------------------------------------------- (en dernier : après les inscriptions)
 
 

@@ -12,14 +12,15 @@ from .validation import KalmanInputError
 __all__ = ["FilterResult", "AdaptiveResult", "FilterRuns", "FilterHistory", "PoseAliases", "freeze", "freeze_fields"]
 
 
-def freeze(arr: np.ndarray) -> np.ndarray:
-    """Copie en lecture seule (les résultats sont immuables). Un tableau déjà figé par cette fonction
+def freeze(arr: np.ndarray, dtype: type = float) -> np.ndarray:
+    """Copie en lecture seule (les résultats sont immuables), de type ``dtype`` (``float`` par défaut ;
+    ``bool`` ou ``np.intp`` pour des masques et des indices). Un tableau déjà figé par cette fonction
     (``float64``, en lecture seule, propriétaire de ses données) est rendu tel quel : reconstruire un
     résultat à partir d'un autre ne recopie pas ses tableaux."""
-    if (isinstance(arr, np.ndarray) and arr.dtype == np.float64 and not arr.flags.writeable
+    if (dtype is float and isinstance(arr, np.ndarray) and arr.dtype == np.float64 and not arr.flags.writeable
             and arr.flags.owndata):
         return arr
-    out = np.array(arr, dtype=float, copy=True)
+    out = np.array(arr, dtype=dtype, copy=True)
     out.setflags(write=False)
     return out
 

@@ -34,6 +34,9 @@ __all__ = [
     "check_instance",
     "call_user_function",
     "check_finite_output",
+    "as_probability",
+    "as_positive_number",
+    "as_integer",
 ]
 
 
@@ -384,3 +387,40 @@ def check_finite_output(name: str, arr: np.ndarray, x: np.ndarray, what: str = "
             f"x = {np.array2string(np.asarray(x), precision=4)}."
         )
     return arr
+
+
+# --------------------------------------------------------------------------- nombres d'un réglage (issue 37)
+
+
+def _scalar(name: str, value: Any, expected: str) -> float:
+    """Un nombre réel fini (pas un booléen, pas un tableau) ; sinon une erreur qui dit ``expected``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not math.isfinite(float(value)):
+        raise KalmanInputError(f"« {name} » doit être {expected} ; reçu {value!r}.")
+    return float(value)
+
+
+def as_probability(name: str, value: Any, *, one: bool = False) -> float:
+    r"""Une probabilité strictement positive : dans :math:`(0, 1)`, ou :math:`(0, 1]` si ``one`` (une
+    probabilité de détection peut valoir 1, une probabilité de porte non : la porte serait infinie)."""
+    expected = "une probabilité dans ]0, 1]" if one else "une probabilité strictement entre 0 et 1"
+    p = _scalar(name, value, expected)
+    if not (0.0 < p < 1.0 or (one and p == 1.0)):
+        raise KalmanInputError(f"« {name} » doit être {expected} ; reçu {value!r}.")
+    return p
+
+
+def as_positive_number(name: str, value: Any, what: str = "un nombre strictement positif") -> float:
+    """Un nombre réel fini strictement positif ; ``what`` précise ce qu'il représente dans le message."""
+    x = _scalar(name, value, what)
+    if not x > 0.0:
+        raise KalmanInputError(f"« {name} » doit être {what} ; reçu {value!r}.")
+    return x
+
+
+def as_integer(name: str, value: Any, low: int, what: str = "") -> int:
+    """Un entier (pas un booléen) supérieur ou égal à ``low``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+        extra = f" ({what})" if what else ""
+        raise KalmanInputError(f"« {name} » doit être un entier ≥ {low}{extra} ; reçu {value!r}.")
+    return int(value)

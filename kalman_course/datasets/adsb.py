@@ -35,8 +35,8 @@ import numpy as np
 
 from ..core.results import freeze
 
-__all__ = ["Flight", "samu31", "calibration_toulouse", "provenance", "enu_from_geodetic", "repair_int8_track",
-           "FOOT", "KNOT"]
+__all__ = ["Flight", "Traffic", "samu31", "calibration_toulouse", "toulouse_traffic", "provenance",
+           "enu_from_geodetic", "repair_int8_track", "FOOT", "KNOT"]
 
 DATA = Path(__file__).resolve().parent / "data"
 #: Un pied (m) et un nœud (m/s).
@@ -139,10 +139,8 @@ def provenance() -> dict:
     return json.loads((DATA / "adsb.json").read_text(encoding="utf-8"))
 
 
-@lru_cache(maxsize=None)
-def _table(name: str) -> tuple[tuple[str, ...], np.ndarray]:
-    """En-tête et valeurs de l'extrait ``name`` ; vérifie son SHA-256 contre la provenance."""
-    info = provenance()["flights"][name]
+def _read_extract(info: dict) -> tuple[tuple[str, ...], np.ndarray]:
+    """En-tête et valeurs de l'extrait décrit par ``info`` (entrée de la provenance) ; vérifie son SHA-256."""
     data = gzip.decompress((DATA / info["extract"]).read_bytes())
     if hashlib.sha256(data).hexdigest() != info["extract_sha256"]:
         raise RuntimeError(f"L'extrait {info['extract']} ne correspond pas à sa provenance (SHA-256) : "
@@ -151,6 +149,12 @@ def _table(name: str) -> tuple[tuple[str, ...], np.ndarray]:
     header = tuple(lines[0].split(","))
     table = np.array([[float(v) if v else np.nan for v in line.split(",")] for line in lines[1:]])
     return header, table
+
+
+@lru_cache(maxsize=None)
+def _table(name: str) -> tuple[tuple[str, ...], np.ndarray]:
+    """En-tête et valeurs de l'extrait du vol ``name`` ; vérifie son SHA-256 contre la provenance."""
+    return _read_extract(provenance()["flights"][name])
 
 
 def _velocity_reports(time_ms: np.ndarray, speed_kt: np.ndarray, track_deg: np.ndarray, t0_ms: float):
@@ -182,12 +186,20 @@ def _utc(ms: float) -> str:
 
 def _flight(name: str, time_column: str) -> Flight:
     header, table = _table(name)
-    col = {h: table[:, i] for i, h in enumerate(header)}
+    return _build_flight(name, provenance()["flights"][name]["description"],
+                         {h: table[:, i] for i, h in enumerate(header)}, time_column)
+
+
+def _build_flight(name: str, description: str, col: dict[str, np.ndarray], time_column: str,
+                  origin: tuple[float, float] | None = None, t0_ms: float | None = None) -> Flight:
+    """Un vol à partir des colonnes de son extrait : une ligne par position (sa première apparition dans la
+    colonne ``time_column``), projetée dans le plan tangent en ``origin`` (latitude, longitude ; par défaut la
+    première position), temps comptés depuis ``t0_ms`` (par défaut la première position)."""
     pos_ms = col[time_column]
     first = np.unique(pos_ms, return_index=True)[1]  # une ligne par position (sa première apparition)
-    t0 = pos_ms[first[0]]
+    t0 = pos_ms[first[0]] if t0_ms is None else t0_ms
     lat, lon = col["latitude_deg"][first], col["longitude_deg"][first]
-    east, north = enu_from_geodetic(lat, lon, lat[0], lon[0])
+    east, north = enu_from_geodetic(lat, lon, *((lat[0], lon[0]) if origin is None else origin))
     t = (pos_ms[first] - t0) / 1000.0
     track = col["track_deg"]
     if np.nanmin(track) < 0.0:  # route tronquée sur 8 bits (vol de calibration) : restaurée par les positions
@@ -197,7 +209,7 @@ def _flight(name: str, time_column: str) -> Flight:
     vt, ve, vn = _velocity_reports(col["timestamp_ms"], col["groundspeed_kt"], track, t0)
     return Flight(
         name=name,
-        description=provenance()["flights"][name]["description"],
+        description=description,
         start_utc=_utc(t0),
         t=t,
         east=east,
@@ -220,3 +232,59 @@ def samu31() -> Flight:
 def calibration_toulouse() -> Flight:
     r"""Le vol de calibration de Toulouse (16 juin 2017, 3 h 27 min, une position toutes les 5 s)."""
     return _flight("calibration_toulouse", "timestamp_ms")
+
+
+@dataclass(frozen=True, eq=False)
+class Traffic:
+    r"""Plusieurs vols rejoués sur une **horloge commune**, dans un **plan tangent commun**.
+
+    ``flights`` : les :class:`Flight` (``t`` en secondes depuis le début de la fenêtre de chaque vol ; ``east``,
+    ``north`` en mètres dans le plan tangent à ``origin``) ; ``window`` : durée commune des fenêtres (s) ;
+    ``origin`` : (latitude, longitude) de l'origine (degrés) et ``origin_name`` ; ``description``, ``source``."""
+
+    flights: tuple
+    window: float
+    origin: tuple
+    origin_name: str
+    description: str
+    source: str = SOURCE
+
+    def __len__(self) -> int:
+        return len(self.flights)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Les indicatifs des vols."""
+        return tuple(f.name for f in self.flights)
+
+    def positions(self, t) -> np.ndarray:
+        r"""Positions (est, nord) de chaque vol aux instants ``t`` (K,) de l'horloge commune : (K, A, 2) m,
+        interpolées linéairement entre les positions ADS-B de chaque vol."""
+        t = np.asarray(t, dtype=float)
+        return np.stack([np.stack([np.interp(t, f.t, f.east), np.interp(t, f.t, f.north)], axis=-1)
+                         for f in self.flights], axis=1)
+
+    def __repr__(self) -> str:
+        return f"<Trafic : {len(self)} vols ({', '.join(self.names)}), fenêtres de {self.window:.0f} s>"
+
+
+@lru_cache(maxsize=1)
+def toulouse_traffic() -> Traffic:
+    r"""Cinq vols autour de Toulouse-Blagnac (hélicoptère SAMU 31, avion de prises de vues Pixair, vol de
+    calibration de 2017, deux vols de calibration SAVAN de 2022), pris chacun sur une fenêtre de 5 min et
+    **rejoués sur une horloge commune** : ils ont volé des jours différents, la scène les superpose (l'instant
+    0 de chacun est le début de sa fenêtre, choisie pour que les trajectoires se croisent). Positions dans le
+    plan tangent à l'aérodrome de Toulouse-Blagnac ; instants propres des positions (``last_position``
+    d'OpenSky) quand le fichier d'origine les donne."""
+    info = provenance()["traffic"]
+    header, table = _read_extract(info)
+    col = {h: table[:, i] for i, h in enumerate(header)}
+    origin = (info["origin"]["latitude_deg"], info["origin"]["longitude_deg"])
+    flights = []
+    for rank, plane in enumerate(info["aircraft"]):
+        rows = col["aircraft"] == rank
+        own = {h: v[rows] for h, v in col.items()}
+        time_column = "last_position_ms" if np.isfinite(own["last_position_ms"]).all() else "timestamp_ms"
+        flights.append(_build_flight(plane["callsign"], plane["description"], own, time_column, origin=origin,
+                                     t0_ms=float(plane["window_start_ms"])))
+    return Traffic(tuple(flights), float(info["window_s"]), origin, info["origin"]["name"], info["description"])

@@ -29,6 +29,7 @@ from . import filter_choice  # noqa: F401  (chapitre « Quel filtre choisir ? »
 from . import parallel  # noqa: F401  (chapitre « Filtrer en parallèle dans le temps »)
 from . import invariant  # noqa: F401  (chapitre « Filtrage invariant sur les groupes de Lie »)
 from . import assimilation  # noqa: F401  (partie « Assimilation de données » et son TP)
+from . import multitarget  # noqa: F401  (chapitres « Fouillis et association », « Gérer les pistes » : issue 37)
 from ._registry import REGISTRY, FigureSpec, draw, names, new_figure, register
 
 __all__ = ["REGISTRY", "FigureSpec", "draw", "names", "new_figure", "register"]

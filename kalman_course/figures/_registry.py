@@ -56,6 +56,11 @@ CHAPTER_TITLES: dict[str, str] = {
     "methodes-variationnelles": "Méthodes variationnelles",
     "td-assimilation": "TD 6 — Assimilation de données à la main",
     "tp-assimilation": "TP 6 — L'ETKF sur Lorenz-96",
+    # plusieurs cibles (issue 37)
+    "fouillis-association": "Fouillis et association",
+    "gestion-pistes": "Gérer les pistes",
+    "td-plusieurs-cibles": "TD 8 — Plusieurs cibles à la main",
+    "tp-plusieurs-cibles": "TP 7 — Plusieurs cibles : l'association probabiliste (PDA)",
 }
 
 #: Résolution des figures affichées dans les carnets (pixels par pouce).

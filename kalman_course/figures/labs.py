@@ -12,7 +12,7 @@ import textwrap
 
 import numpy as np
 
-from ..scenarios.labs import LAB_SAMU_GATE, nile_lab, pendulum_lab, samu_lab, tag_lab, voltage_lab
+from ..scenarios.labs import LAB_SAMU_GATE, nile_lab, pda_lab, pendulum_lab, samu_lab, tag_lab, voltage_lab
 from ._registry import new_figure, register
 from .likelihood import FLOW, _year_formatter
 
@@ -175,6 +175,35 @@ def samu_lab_figure(cv_model=None, nis_gate=None, van_loan=None, imm_mix=None, m
     az.set_xlabel("temps depuis la première position (s)")
     az.set_ylabel("probabilité du régime agité μ (sans unité)")
     az.set_title("IMM calme/agité : vos points doivent tomber sur la courbe du paquet", fontsize=9)
+    az.legend(loc="upper left", fontsize=8)
+    for a in (ax, az):
+        a.grid(alpha=0.3)
+    _note(fig, run.message)
+    return fig
+
+
+@register("tp-pda", chapter="tp-plusieurs-cibles",
+          title="TP 7 : votre PDA et celle du paquet sur l'hélicoptère SAMU 31 dans un fouillis dense")
+def pda_lab_figure(pda_weights=None, pda_update=None):
+    run = pda_lab(pda_weights, pda_update)
+    truth, det, t = run.data["truth"], run.data["detections"], run.data["t"]
+    fig, (ax, az) = new_figure(1, 2, width=9.0, height=4.0, gridspec_kw={"width_ratios": [1.1, 1.0]})
+    ax.plot(det[:, 0] / 1e3, det[:, 1] / 1e3, "+", color="0.6", ms=4, label="détections (à moins de 1,5 km)")
+    ax.plot(truth[:, 0] / 1e3, truth[:, 1] / 1e3, color="black", lw=3, alpha=0.35, label="trajectoire vraie")
+    ax.plot(run.reference["x"][:, 0] / 1e3, run.reference["x"][:, 1] / 1e3, color=PACKAGE, lw=1.8,
+            label="PDA du paquet")
+    az.plot(t, run.reference["error"], color=PACKAGE, lw=1.8, label="PDA du paquet")
+    if run.student is not None:
+        ax.plot(run.student["x"][:, 0] / 1e3, run.student["x"][:, 1] / 1e3, "o", ms=3.5, mfc="none", color=YOURS,
+                label="votre PDA")
+        az.plot(t, run.student["error"], "o", ms=3.5, mfc="none", color=YOURS, label="votre PDA")
+    ax.set_xlabel("est (km)")
+    ax.set_ylabel("nord (km)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(loc="lower left", fontsize=7)
+    ax.set_title("Vos points doivent tomber sur la piste du paquet", fontsize=10)
+    az.set_xlabel("temps (s)")
+    az.set_ylabel("erreur de position (m)")
     az.legend(loc="upper left", fontsize=8)
     for a in (ax, az):
         a.grid(alpha=0.3)

@@ -67,6 +67,7 @@ from . import filter_choice  # noqa: F401  (« Quel filtre choisir ? »)
 from . import parallel  # noqa: F401  (« Filtrer en parallèle dans le temps »)
 from . import invariant  # noqa: F401  (« Filtrage invariant sur les groupes de Lie »)
 from . import assimilation  # noqa: F401  (« Le filtre d'ensemble en grande dimension », « Méthodes variationnelles »)
+from . import multitarget  # noqa: F401  (« Fouillis et association », « Gérer les pistes » : issue 37)
 
 __all__ = [
     "ChoiceParameter",

@@ -28,6 +28,7 @@ from typing import Any, Callable, NamedTuple
 
 from .grading import Case, Exercise, Mistake, Output, grade
 from .linear import JOSEPH_UPDATE, KF_PREDICT, KF_UPDATE, NIS
+from .multitarget import PDA_UPDATE, PDA_WEIGHTS
 from .nonlinear import EKF_UPDATE, SO3_EXP, TAG_JACOBIAN
 from .invariant import SE2_EXP, SE2_INVARIANT_PREDICT, SE2_INVARIANT_UPDATE
 from .sampling import PARTICLE_WEIGHTS, SIGMA_POINTS, SYSTEMATIC_RESAMPLE, UNSCENTED_TRANSFORM
@@ -46,6 +47,7 @@ _EXERCISES: tuple[Exercise, ...] = (
     RTS_STEP, EM_M_STEP,
     CV_MODEL, VAN_LOAN, NIS_GATE, IMM_MIX, MODE_PROBABILITIES, IMM_MERGE,
     ETKF_UPDATE, GASPARI_COHN,
+    PDA_WEIGHTS, PDA_UPDATE,
 )
 _BY_ID = {ex.id: ex for ex in _EXERCISES}
 

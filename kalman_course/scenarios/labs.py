@@ -13,6 +13,8 @@ Le code de l'étudiant n'interrompt jamais l'expérience : s'il échoue, ``stude
 * :func:`nile_lab` — TP 4 : le lisseur RTS et l'étape M de l'étudiant sur le Nil ;
 * :func:`samu_lab` — TP 5 : le modèle à vitesse presque constante, la porte, la discrétisation de Van Loan et
   l'IMM de l'étudiant sur le vol réel de l'hélicoptère SAMU 31.
+* :func:`pda_lab` — TP 7 : les poids et la correction PDA de l'étudiant, sur l'hélicoptère de la scène de
+  Blagnac dans un fouillis dense.
 """
 
 from __future__ import annotations
@@ -39,9 +41,10 @@ from .tag import TAG_RANGE_STD, tag_data, tag_model, tag_ranges
 from .voltage import TRUE_VOLTAGE, constant_voltage_measurements, constant_voltage_model
 
 __all__ = [
-    "LabRun", "voltage_lab", "tag_lab", "pendulum_lab", "nile_lab", "samu_lab",
+    "LabRun", "voltage_lab", "tag_lab", "pendulum_lab", "nile_lab", "samu_lab", "pda_lab",
     "LAB_UKF", "LAB_PARTICLES", "LAB_PF_SEED", "LAB_NILE_PRIOR", "LAB_EM_START", "LAB_EM_ITERATIONS",
     "LAB_SAMU_Q", "LAB_SAMU_POSITION_STD", "LAB_SAMU_GATE", "LAB_SAMU_MODES", "LAB_SAMU_SWITCH",
+    "LAB_PDA_CLUTTER",
 ]
 
 #: Points sigma de l'UKF du TP 3 : :math:`\alpha = 1`, :math:`\beta = 2`, :math:`\kappa = 0`.
@@ -63,6 +66,8 @@ LAB_SAMU_GATE = 0.999
 #: Densités (m²/s³) des régimes calme et agité de l'IMM du TP 5, et probabilité de quitter son régime.
 LAB_SAMU_MODES = (3.0, 100.0)
 LAB_SAMU_SWITCH = 0.02
+#: Densité du fouillis du TP 7 (par m² et par relevé : 44 fausses détections par relevé sur la zone).
+LAB_PDA_CLUTTER = 1e-7
 
 
 @dataclass(frozen=True, eq=False)
@@ -364,3 +369,54 @@ def samu_lab(cv_model: Callable | None = None, nis_gate: Callable | None = None,
     rate_t, rate = measured_turn_rate(track.flight)
     return LabRun({"t": np.asarray(track.t), "y": y, "y_bad": y_bad, "outliers": outliers, "rate_t": rate_t,
                    "rate": rate}, reference, student, message)
+
+# --------------------------------------------------------------------------- TP 7 : la PDA
+
+
+def pda_lab(pda_weights: Callable | None = None, pda_update: Callable | None = None) -> LabRun:
+    r"""Un filtre PDA sur l'hélicoptère SAMU 31 de la scène de Blagnac (:mod:`~kalman_course.scenarios.traffic`,
+    :math:`P_D` = 0,9, fouillis :data:`LAB_PDA_CLUTTER`, porte 0,99) : à chaque relevé, prédiction du paquet,
+    puis les poids ``pda_weights`` et la correction ``pda_update`` de l'étudiant, contre
+    :func:`~kalman_course.pda_update`. Les détections des autres avions sont, pour ce filtre, du fouillis.
+    L'a priori est la position et la vitesse vraies au premier relevé, avec la covariance d'une naissance
+    par deux points. ``data`` : ``t``, ``truth`` (K, 2), ``detections`` (points des relevés à moins de 1,5 km
+    de l'hélicoptère) ; ``reference`` et ``student`` : ``x`` (K, 2) et ``error`` (K,) m."""
+    from ..multitarget.pda import pda_update as package_pda_update
+    from . import traffic
+
+    pda_weights, pda_update = _solution("pda-weights", pda_weights), _solution("pda-update", pda_update)
+    model = traffic.radar_model()
+    scans = traffic.radar_scans(traffic.DETECTION_PROBABILITY, LAB_PDA_CLUTTER)
+    truth = scans.truth[:, 0]
+    A, C, Q, R = (np.array(model.A), np.array(model.C), np.array(model.Q), np.array(model.R))
+    dt = traffic.DT
+    x0 = np.concatenate([truth[0], (truth[1] - truth[0]) / dt])
+    P0 = np.block([[R, R / dt], [R / dt, 2.0 * R / dt ** 2]])
+    settings = dict(detection_probability=traffic.DETECTION_PROBABILITY, clutter_density=LAB_PDA_CLUTTER,
+                    gate_probability=traffic.GATE_PROBABILITY)
+
+    def package():
+        x, P, out = x0, P0, [x0[:2]]
+        for z in scans.scans[1:]:
+            x, P = A @ x, A @ P @ A.T + Q
+            step = package_pda_update(model, x, P, z, **settings)
+            x, P = step.x, step.P
+            out.append(x[:2])
+        return np.array(out)
+
+    def run():
+        x, P, out = x0.copy(), P0.copy(), [x0[:2]]
+        for z in scans.scans[1:]:
+            x, P = A @ x, A @ P @ A.T + Q
+            S = C @ P @ C.T + R
+            beta = np.asarray(pda_weights(z - C @ x, S, *settings.values()), dtype=float)
+            x, P = pda_update(x, P, z, C, R, beta)
+            x, P = np.asarray(x, dtype=float).reshape(4), np.asarray(P, dtype=float).reshape(4, 4)
+            out.append(x[:2])
+        return {"x": np.array(out), "error": np.linalg.norm(np.array(out) - truth, axis=1)}
+
+    ref = package()
+    student, message = _run(run)
+    near = np.vstack([z[np.linalg.norm(z - truth[k], axis=1) < 1500.0] for k, z in enumerate(scans.scans)])
+    data = {"t": scans.t, "truth": truth, "detections": near}
+    return LabRun(data, {"x": ref, "error": np.linalg.norm(ref - truth, axis=1)}, student, message)

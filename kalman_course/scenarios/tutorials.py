@@ -21,6 +21,8 @@ et les tests (qui comparent les deux).
   sujet d'examen.
 * :func:`se2_by_hand` — TD 7 : une exponentielle et une adjointe de SE(2), puis une correction de l'EKF
   invariant.
+* :func:`pda_by_hand` — TD 8 : une correction PDA scalaire avec deux détections ;
+* :func:`jpda_by_hand` — TD 8 : les probabilités JPDA de deux pistes et deux détections, par énumération.
 """
 
 from __future__ import annotations
@@ -35,6 +37,8 @@ from ..filters.particle import systematic_resample
 from ..filters.smoothers import rts_smoother
 from ..filters.unscented import unscented_transform
 from ..likelihood import em_step
+from ..multitarget.jpda import joint_marginals
+from ..multitarget.pda import PDAUpdate, pda_update
 
 __all__ = [
     "THERMOMETER", "SQUARE_UT", "FOUR_WEIGHTS", "FOUR_U", "ENSEMBLE_EXAMPLE", "THREE_STEPS",
@@ -43,6 +47,7 @@ __all__ = [
     "EXAM_SMOOTHING", "EXAM_TRACKING", "cv_noise_example", "gate_example", "imm_step", "parallel_elements",
     "information_step", "exam_stationary", "exam_range_update", "exam_smoothing", "exam_tracking",
     "SE2_BY_HAND", "SE2ByHand", "se2_by_hand",
+    "PDA_BY_HAND", "JPDA_WEIGHTS", "pda_by_hand", "jpda_by_hand",
 ]
 
 #: TD 1 : a priori (°C), sa variance (°C²), mesure (°C), variance de la mesure (°C²).
@@ -57,6 +62,13 @@ FOUR_U = 0.5
 ENSEMBLE_EXAMPLE = {"P_prior": 4.0, "R": 1.0, "members": 200_000, "seed": 5}
 #: TD 3 : marche aléatoire x_{k+1} = x_k + w_k, y_k = x_k + v_k, Q = R = 1, a priori N(0, 1), mesures.
 THREE_STEPS = {"Q": 1.0, "R": 1.0, "x0": 0.0, "P0": 1.0, "y": (1.0, 3.0, 2.0)}
+#: TD 8 : une piste scalaire (a priori 0, variance 3), R = 1, deux détections ; P_D, P_G et λ (par unité de
+#: longueur).
+PDA_BY_HAND = {"x_prior": 0.0, "P_prior": 3.0, "R": 1.0, "detections": (1.0, -2.0), "P_D": 0.8, "P_G": 0.9,
+               "lambda": 0.1}
+#: TD 8 : poids PDA (divisés par w₀) de deux pistes pour deux détections : colonne 0, aucune détection.
+JPDA_WEIGHTS = np.array([[1.0, 4.0, 1.0], [1.0, 2.0, 3.0]])
+JPDA_WEIGHTS.setflags(write=False)
 
 
 def thermometer_update():
@@ -318,3 +330,20 @@ def se2_by_hand() -> SE2ByHand:
     c = SE2_BY_HAND
     return SE2ByHand(se2_exp(c["xi"]), se2_adjoint(c["T_pred"]),
                      se2_invariant_update(c["T_pred"], c["P_pred"], c["y"], c["gnss_std"]))
+
+
+# --------------------------------------------------------------------------- TD 8 : plusieurs cibles
+
+
+def pda_by_hand() -> PDAUpdate:
+    """La correction PDA du TD 8 par :func:`kalman_course.pda_update` (modèle scalaire, C = 1)."""
+    c = PDA_BY_HAND
+    model = LinearGaussianModel(1.0, 1.0, 0.0, c["R"])
+    return pda_update(model, [c["x_prior"]], [[c["P_prior"]]], np.array(c["detections"])[:, None],
+                      detection_probability=c["P_D"], clutter_density=c["lambda"], gate_probability=c["P_G"])
+
+
+def jpda_by_hand() -> np.ndarray:
+    """Les probabilités JPDA (2, 3) du TD 8, par l'énumération du paquet
+    (:func:`kalman_course.multitarget.jpda.joint_marginals`) sur les poids :data:`JPDA_WEIGHTS`."""
+    return joint_marginals(np.array(JPDA_WEIGHTS), np.array(JPDA_WEIGHTS)[:, 1:] > 0)
