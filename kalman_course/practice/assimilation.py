@@ -134,9 +134,10 @@ ETKF_UPDATE = Exercise(
     mistakes=(
         Mistake("cholesky", "racine de Cholesky au lieu de la racine symétrique",
                 "La transformée est la racine **symétrique** T = [I + Y R⁻¹ Yᵀ/(N − 1)]^(−1/2) (par exemple "
-                "V diag(s^(−1/2)) Vᵀ avec `np.linalg.eigh`). Une racine de Cholesky donne la même covariance, "
-                "mais elle n'est pas symétrique : T 1 ≠ 1, elle déplace la moyenne de l'ensemble et mélange les "
-                "membres au hasard de leur ordre.",
+                "V diag(s^(−1/2)) Vᵀ avec `np.linalg.eigh`). Le facteur de Cholesky L (L Lᵀ = M⁻¹), triangulaire, "
+                "n'est pas symétrique : appliqué aux anomalies, il ne garde pas T 1 = 1 (la moyenne de "
+                "l'ensemble glisse) et, comme Lᵀ L ≠ M⁻¹, la covariance analysée n'est plus celle de Kalman ; "
+                "son effet dépend en plus de l'ordre des membres.",
                 _etkf_cholesky, culprit=(r"cholesky",)),
         Mistake("inflation-forecast", "inflation appliquée à l'ensemble prévu",
                 "L'inflation multiplie les anomalies **analysées** : E_a = x̄_a + λ T A. Gonfler l'ensemble prévu "
@@ -145,7 +146,8 @@ ETKF_UPDATE = Exercise(
         Mistake("no-n-minus-one", "anomalies non divisées par √(N − 1)",
                 "La covariance d'échantillon est P = AᵀA/(N − 1) : la transformée est "
                 "[I + Y R⁻¹ Yᵀ/(N − 1)]^(−1/2) et le gain A ᵀY (YᵀY + (N − 1) R)⁻¹. Sans le facteur N − 1, "
-                "l'ensemble se croit N − 1 fois plus dispersé et les observations le resserrent trop.",
+                "la covariance de l'ensemble est comptée N − 1 fois trop grande : les observations pèsent trop, "
+                "déplacent trop la moyenne et resserrent trop l'ensemble.",
                 _etkf_no_n_minus_one, culprit=(r"np\.eye\(\s*N\s*\)\s*\+",)),
         Mistake("r-not-inverted", "R au lieu de R⁻¹ dans la transformée",
                 "La transformée pondère les anomalies observées par la précision des observations : "
