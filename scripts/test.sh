@@ -45,7 +45,7 @@ package=0
 # Les deux sessions à la même priorité : le système partage les cœurs entre leurs processus, et la session du
 # livre en a plusieurs (noyaux, visiteurs et Chromium, XeLaTeX). (En priorité basse, celle du paquet ne
 # recevait presque rien pendant les tests du navigateur et finissait seule, 150 s après l'autre, sur un cœur.)
-.venv/bin/python -m pytest -m "not ($BOOK_MARKS)" || package=$?
+.venv/bin/python -m pytest -m "not ($BOOK_MARKS)" --durations=15 || package=$?
 book=0
 wait "$book_pid" || book=$?
 trap - INT TERM
