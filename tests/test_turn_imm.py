@@ -198,6 +198,12 @@ def test_on_the_helicopter_the_turn_imm_predicts_better_and_estimates_the_turn_r
     assert h.rate_correlation > 0.9
     assert h.correlation < h.correlation_cvcv
     assert 0.3 < h.correlation < 0.9
+    # … car, quand l'hélicoptère vole presque droit, le régime virage reste probable (un virage à ω ≈ 0 est une
+    # ligne droite), bien plus que le régime agité
+    straight = np.abs(h.rate) < man.STRAIGHT_RATE
+    assert 0.2 < straight.mean() < 0.8
+    assert h.straight_turn_prob == pytest.approx(h.turn_prob[straight].mean())
+    assert h.straight_turn_prob > 3 * h.straight_agitated_prob
     # le même IMM à la main : la ω̂ combinée est μ_CT ω̂_CT (la ligne droite a ω = 0)
     res = h.result
     np.testing.assert_allclose(res.x[:, 4], res.mu[:, 1] * res.x_modes[:, 1, 4], rtol=1e-12, atol=1e-15)
@@ -230,3 +236,16 @@ def test_on_the_simulated_target_the_turn_imm_is_better_in_turns_and_as_consiste
     assert np.all(st.nees_straight < 4.0) and np.all(st.nees_turn > 4.0)
     assert st.nees_turn[ct] < 1.2 * st.nees_turn[cv]
     assert st.turn_rate_rmse < 0.05
+
+
+def test_the_estimated_turn_rate_catches_up_with_each_turn_within_seconds():
+    """Le chapitre : la marche aléatoire de ω met quelques secondes à rejoindre chaque virage. Sur la première
+    trajectoire, au début de chaque virage (et à sa fin), ω̂ est encore loin de la vraie (écart > moitié du
+    saut) ; moins de 8 s plus tard, l'écart est sous la moitié du saut."""
+    st = man.turn_mode_study()
+    w_hat, w = st.example.x[:, 4], st.truth[:, 4]
+    for start, end, rate in man.TURNS:
+        for t0 in (start, end):
+            k = int(np.searchsorted(st.t, t0 + 1.0))
+            gap = np.abs(w_hat[k:k + 8] - w[k:k + 8]) < 0.5 * abs(rate)
+            assert not gap[0] and gap.any(), (t0, w_hat[k:k + 8], w[k:k + 8])

@@ -46,7 +46,7 @@ __all__ = [
     "ManoeuvreStudy", "manoeuvre_study", "HelicopterIMM", "helicopter_imm", "measured_turn_rate",
     "TURN_ACCEL_PSD", "TURN_RATE_PSD", "TURN_RATE_STD0", "HELI_TURN_ACCEL_PSD", "N_RUNS_TURN", "IMM_PAIR",
     "turn_state_prior", "cv_ct_modes", "run_cv_ct", "TurnModeStudy", "turn_mode_study", "HelicopterTurnIMM",
-    "helicopter_turn_imm",
+    "helicopter_turn_imm", "STRAIGHT_RATE",
 ]
 
 #: Vitesse (m/s), pas (s), nombre de pas de la cible simulée.
@@ -279,6 +279,8 @@ HELI_TURN_ACCEL_PSD = 1.0
 N_RUNS_TURN = 12
 #: Les deux IMM comparés : calme/agité (vitesse constante, deux densités) et vitesse constante / virage.
 IMM_PAIR = ("IMM CV/CV", "IMM CV/CT")
+#: En dessous de cette vitesse de rotation mesurée (°/s), l'hélicoptère vole presque droit.
+STRAIGHT_RATE = 1.0
 
 
 def turn_state_prior(x0, P0, turn_rate_std: float = TURN_RATE_STD0) -> tuple[np.ndarray, np.ndarray]:
@@ -403,7 +405,9 @@ class HelicopterTurnIMM:
     ``turn_prob`` (V,) : probabilité du régime virage à ces instants ; ``turn_rate`` (V,) : :math:`\hat\omega`
     combinée (°/s) ; ``correlation`` : corrélation de ``turn_prob`` avec :math:`|` ``rate`` :math:`|` ;
     ``correlation_cvcv`` : la même pour la probabilité du régime agité de l'IMM calme/agité
-    (:func:`helicopter_imm`) ; ``rate_correlation`` : corrélation de :math:`\hat\omega` avec ``rate`` ;
+    (:func:`helicopter_imm`) ; ``straight_turn_prob``, ``straight_agitated_prob`` : probabilités moyennes du
+    régime virage et du régime agité quand l'hélicoptère vole presque droit (:math:`|` ``rate`` :math:`|` <
+    :data:`STRAIGHT_RATE`) ; ``rate_correlation`` : corrélation de :math:`\hat\omega` avec ``rate`` ;
     ``prediction_rms``, ``prediction_rms_cvcv``, ``prediction_rms_single`` (m) : erreur de prédiction des
     positions de cet IMM, de l'IMM calme/agité et du filtre unique appris ; ``log_likelihood``,
     ``log_likelihood_cvcv`` : log-vraisemblances des deux IMM (mêmes mesures)."""
@@ -416,6 +420,8 @@ class HelicopterTurnIMM:
     turn_rate: np.ndarray
     correlation: float
     correlation_cvcv: float
+    straight_turn_prob: float
+    straight_agitated_prob: float
     rate_correlation: float
     prediction_rms: float
     prediction_rms_cvcv: float
@@ -449,9 +455,11 @@ def helicopter_turn_imm(q_straight: float = 0.1, q_turn: float = HELI_TURN_ACCEL
     rate = -heading_rate
     rows = np.searchsorted(np.asarray(track.t), np.round(rate_t, 3))
     prob, w = res.mu[rows, 1], np.rad2deg(res.x[rows, 4])
+    straight = np.abs(rate) < STRAIGHT_RATE
     return HelicopterTurnIMM(
         result=res, t=np.asarray(track.t), rate_t=rate_t, rate=rate, turn_prob=prob, turn_rate=w,
         correlation=float(np.corrcoef(prob, np.abs(rate))[0, 1]), correlation_cvcv=cvcv.correlation,
+        straight_turn_prob=float(prob[straight].mean()), straight_agitated_prob=float(cvcv.mu_at_rate[straight].mean()),
         rate_correlation=float(np.corrcoef(w, rate)[0, 1]),
         prediction_rms=prediction_rms(res, track), prediction_rms_cvcv=cvcv.prediction_rms,
         prediction_rms_single=cvcv.prediction_rms_single, log_likelihood=res.log_likelihood,
