@@ -210,9 +210,9 @@ def test_on_the_helicopter_the_turn_imm_predicts_better_and_estimates_the_turn_r
 
 
 def test_the_helicopter_gain_is_not_a_matter_of_tuning():
-    """L'IMM CV/CT aux réglages du chapitre prédit mieux que l'IMM calme/agité sur toute une grille de ses
-    réglages (calme 0,1 ou 1 m²/s³, agité 30 ou 100 m²/s³ : les meilleurs d'une grille plus large), et, réglé autrement (régime virage 0,3 ou
-    3 m²/s³, q_ω 3·10⁻⁴ ou 3·10⁻³), il reste meilleur que l'IMM calme/agité du chapitre."""
+    """L'IMM CV/CT aux réglages du chapitre prédit mieux que l'IMM calme/agité à ses meilleurs réglages
+    d'une grille plus large (calme 0,1 ou 1 m²/s³, agité 30 ou 100 m²/s³), et, réglé autrement (régime
+    virage 0,3 ou 3 m²/s³, q_ω 3·10⁻⁴ ou 3·10⁻³), il reste meilleur que l'IMM calme/agité du chapitre."""
     h = man.helicopter_turn_imm()
     for q_quiet in (0.1, 1.0):
         for q_man in (30.0, 100.0):

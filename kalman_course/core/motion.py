@@ -30,7 +30,10 @@ Modèles du cours (état rangé positions d'abord, puis vitesses : :math:`[p_1, 
 * :func:`constant_acceleration` — accélération presque constante, *jerk* blanc de densité :math:`q`
   (m²/s⁵) ;
 * :func:`coordinated_turn` — virage coordonné à vitesse de rotation :math:`\omega` inconnue (état
-  :math:`[p_x, p_y, v_x, v_y, \omega]`), modèle **non linéaire** : transition exacte :func:`turn_transition`.
+  :math:`[p_x, p_y, v_x, v_y, \omega]`), modèle **non linéaire** : transition exacte :func:`turn_transition` ;
+  :func:`straight_flight` — la ligne droite sur le même état (:math:`\omega^+ = 0`), l'autre régime d'un IMM
+  vitesse constante / virage. Les deux acceptent un pas variable (``dt=None`` : :math:`\Delta t_k` lu dans
+  la commande :math:`u_k = [\Delta t_k]`, bruit par le gain :func:`turn_noise_gain`).
 """
 
 from __future__ import annotations

@@ -310,7 +310,8 @@ def helicopter_imm_figure():
 
 
 @register("manoeuvre-imm-virage", chapter=MANOEUVRE_CHAPTER,
-          title="L'IMM vitesse constante / virage coordonné sur l'hélicoptère : vitesse de rotation estimée et probabilités des régimes")
+          title="L'IMM vitesse constante / virage coordonné sur l'hélicoptère : vitesse de rotation estimée "
+                "et probabilités des régimes")
 def helicopter_turn_imm_figure():
     h = man.helicopter_turn_imm()
     cvcv = man.helicopter_imm()

@@ -46,7 +46,7 @@ __all__ = [
     "ManoeuvreStudy", "manoeuvre_study", "HelicopterIMM", "helicopter_imm", "measured_turn_rate",
     "TURN_ACCEL_PSD", "TURN_RATE_PSD", "TURN_RATE_STD0", "HELI_TURN_ACCEL_PSD", "N_RUNS_TURN", "IMM_PAIR",
     "turn_state_prior", "cv_ct_modes", "run_cv_ct", "TurnModeStudy", "turn_mode_study", "HelicopterTurnIMM",
-    "helicopter_turn_imm", "STRAIGHT_RATE",
+    "helicopter_turn_imm", "helicopter_cv_ct_filter", "STRAIGHT_RATE",
 ]
 
 #: Vitesse (m/s), pas (s), nombre de pas de la cible simulée.
@@ -335,11 +335,11 @@ class TurnModeStudy:
     :func:`run_cv_ct`) sur les :data:`N_RUNS_TURN` premières trajectoires de :func:`manoeuvre_study`.
 
     ``rmse_straight``, ``rmse_turn`` (2,) : REQM de position (m) hors virages (après 10 s) et en virage ;
-    ``nees_straight``, ``nees_turn`` (2,) : NEES moyens de :math:`[p, v]` correspondants (4 attendu) ;
+    ``nees_straight``, ``nees_turn`` (2,) : NEES moyennes de :math:`[p, v]` correspondantes (4 attendu) ;
     ``turn_rate_rmse`` : REQM (rad/s) de :math:`\hat\omega` (l'estimation combinée) de l'IMM CV/CT ;
     ``t`` (T,) s ; ``turning`` (T,) booléen : un virage et les 10 s qui le suivent ; ``rmse`` (2, T) : REQM
-    de position à chaque pas ; ``nees`` (2, T) : NEES moyen à chaque pas ; ``example`` : son résultat sur la première trajectoire
-    (``truth`` (T, 5), avec :math:`\omega` vraie, et ``y``)."""
+    de position à chaque pas ; ``nees`` (2, T) : NEES moyenne à chaque pas ; ``example`` : le résultat de
+    l'IMM CV/CT sur la première trajectoire (``truth`` (T, 5), avec :math:`\omega` vraie, et ``y``)."""
 
     rmse_straight: np.ndarray
     rmse_turn: np.ndarray
@@ -433,23 +433,34 @@ class HelicopterTurnIMM:
         freeze_fields(self, "t", "rate_t", "rate", "turn_prob", "turn_rate")
 
 
-@lru_cache(maxsize=None)
-def helicopter_turn_imm(q_straight: float = 0.1, q_turn: float = HELI_TURN_ACCEL_PSD,
-                        turn_psd: float = TURN_RATE_PSD, switch: float = 0.05) -> HelicopterTurnIMM:
+def helicopter_cv_ct_filter(q_straight: float = 0.1, q_turn: float = HELI_TURN_ACCEL_PSD,
+                            turn_psd: float = TURN_RATE_PSD, switch: float = 0.05) -> IMMResult:
     r"""L'IMM vitesse constante / virage coordonné (:func:`cv_ct_modes`, EKF dans l'IMM) sur les deux capteurs
-    du vol SAMU 31 : :math:`C = [I_4\ 0]` (positions et vitesses), écarts-types de mesure appris, pas
-    variable :math:`\Delta t_k` passé en commande (``u = track.dt[:, None]``), a priori de
-    :func:`~kalman_course.scenarios.helicopter.helicopter_track` complété de :math:`\omega_0 = 0`. Le régime
-    ligne droite a la densité du régime calme de :func:`helicopter_imm` (0,1 m²/s³) ; comparé à cet IMM."""
+    du vol SAMU 31 : :math:`C = [I_4\ 0]` (positions et vitesses mesurées, pas :math:`\omega`), écarts-types
+    de mesure appris, pas variable :math:`\Delta t_k` passé en commande (``u = track.dt[:, None]``), a priori
+    de :func:`~kalman_course.scenarios.helicopter.helicopter_track` complété de :math:`\omega_0 = 0` à
+    :data:`TURN_RATE_STD0` près. Le régime ligne droite a par défaut la densité du régime calme de
+    :func:`helicopter_imm` (0,1 m²/s³)."""
     from .helicopter import fitted_parameters
 
     track = helicopter_track("both")
     _, sp, sv = fitted_parameters("both")
-    R = np.diag([sp**2] * 2 + [sv**2] * 2)
-    modes = cv_ct_modes(None, q_straight, q_turn, turn_psd, R, C=np.eye(5)[:4])
-    x0, P0 = turn_state_prior(track.x0, track.P0)
-    res = imm_filter(modes, track.y, x0, P0, np.asarray(track.dt)[:, None], transition=imm_transition(switch),
-                     mu0=[1.0 - switch, switch])
+    R = np.diag([sp**2] * 2 + [sv**2] * 2)                                 # positions (m), vitesses (m/s)
+    modes = cv_ct_modes(None, q_straight, q_turn, turn_psd, R, C=np.eye(5)[:4])  # état [e, n, v_e, v_n, ω]
+    x0, P0 = turn_state_prior(track.x0, track.P0)                          # ω₀ = 0
+    u = np.asarray(track.dt)[:, None]                                      # u_k = [Δt_k]
+    return imm_filter(modes, track.y, x0, P0, u, transition=imm_transition(switch), mu0=[1.0 - switch, switch])
+
+
+@lru_cache(maxsize=None)
+def helicopter_turn_imm(q_straight: float = 0.1, q_turn: float = HELI_TURN_ACCEL_PSD,
+                        turn_psd: float = TURN_RATE_PSD, switch: float = 0.05) -> HelicopterTurnIMM:
+    r"""L'IMM vitesse constante / virage coordonné sur l'hélicoptère (:func:`helicopter_cv_ct_filter`), comparé
+    à l'IMM calme/agité de mêmes ``q_straight`` et ``switch`` (:func:`helicopter_imm`, régime agité
+    30 m²/s³) et au filtre unique appris, et la vitesse de rotation mesurée (:func:`measured_turn_rate`,
+    changée de signe)."""
+    track = helicopter_track("both")
+    res = helicopter_cv_ct_filter(q_straight, q_turn, turn_psd, switch)
     cvcv = helicopter_imm(q_straight, 30.0, switch)
     rate_t, heading_rate = measured_turn_rate(track.flight)
     rate = -heading_rate
@@ -459,7 +470,8 @@ def helicopter_turn_imm(q_straight: float = 0.1, q_turn: float = HELI_TURN_ACCEL
     return HelicopterTurnIMM(
         result=res, t=np.asarray(track.t), rate_t=rate_t, rate=rate, turn_prob=prob, turn_rate=w,
         correlation=float(np.corrcoef(prob, np.abs(rate))[0, 1]), correlation_cvcv=cvcv.correlation,
-        straight_turn_prob=float(prob[straight].mean()), straight_agitated_prob=float(cvcv.mu_at_rate[straight].mean()),
+        straight_turn_prob=float(prob[straight].mean()),
+        straight_agitated_prob=float(cvcv.mu_at_rate[straight].mean()),
         rate_correlation=float(np.corrcoef(w, rate)[0, 1]),
         prediction_rms=prediction_rms(res, track), prediction_rms_cvcv=cvcv.prediction_rms,
         prediction_rms_single=cvcv.prediction_rms_single, log_likelihood=res.log_likelihood,
