@@ -78,12 +78,14 @@ class Scene:
                                prob_detect=tr.DETECTION_PROBABILITY, prob_gate=tr.GATE_PROBABILITY)
 
 
-def line(label, ours, theirs, calls, diff):
+def line(label, ours, theirs, calls, diff=None):
+    """Une ligne du tableau ; ``diff`` None : pas d'écart à comparer (algorithmes différents)."""
     ratio = theirs / ours
     status = "OK" if ratio >= TARGET else "SOUS LA CIBLE"
+    gap = "sans objet (gestion des pistes différente)" if diff is None else format_spec(diff, '.1e')
     print(f"{label:46s} kalman_course {format_spec(ours / calls * 1e6, '.0f'):>8s} µs  Stone Soup "
           f"{format_spec(theirs / calls * 1e6, '.0f'):>9s} µs  rapport {format_spec(ratio, '.0f'):>5s} "
-          f"(cible ≥ {format_spec(TARGET, 'g')})  {status}  |écart| {format_spec(diff, '.1e')}")
+          f"(cible ≥ {format_spec(TARGET, 'g')})  {status}  |écart| {gap}")
     return ratio
 
 
@@ -212,7 +214,7 @@ def bench_tracker(scene: Scene, repeat: int) -> float:
 
     t_ours, mine = best_time(ours, repeat, time.process_time)
     t_ss, counts = best_time(theirs, 1, time.process_time)
-    ratio = line("pisteur entier (JPDA), par relevé", t_ours, t_ss, tr.N_SCANS, float("nan"))
+    ratio = line("pisteur entier (JPDA), par relevé", t_ours, t_ss, tr.N_SCANS)
     print(f"{'':46s} pistes confirmées au dernier relevé : kalman_course {mine.ids[-1].size}, Stone Soup "
           f"{counts[-1]} (gestion des pistes différente)")
     return ratio

@@ -859,8 +859,10 @@ def _laptop_checks(html_file: Path, html: str, toc: set[Path]) -> list[tuple[str
     checks: list[tuple[str, Callable]] = [("pages", _check_page)]
     if html_file in toc:
         checks.append(("panneaux", _check_panels))
-        if not html_file.stem.startswith(("tp-", "td-")):  # TD et TP : pas de figure à curseurs
-            checks.append(("chapitres", _check_chapter_sliders))  # (PRACTICE_PAGES, test_chapter_pedagogy.py)
+        # TD, TP et sujet d'examen : pages d'exercices, sans figure à curseurs (PRACTICE_PAGES,
+        # test_chapter_pedagogy.py)
+        if not (html_file.stem.startswith(("tp-", "td-")) or html_file.stem == "sujet-examen"):
+            checks.append(("chapitres", _check_chapter_sliders))
     if MARKER in html:
         checks.append(("curseurs", _check_static_sliders))
     return checks

@@ -178,6 +178,7 @@ def _gc_cases() -> list[Case]:
                  4.0),
         _gc_case("distances au hasard, rayon 0,5", rng.uniform(0.0, 2.0, 15), 0.5),
         _gc_case("rayon infini (aucune localisation)", np.array([0.0, 3.0, 1e6]), np.inf),
+        _gc_case("une seule distance, égale au rayon 3 (ρ ≈ 0,63)", np.array([3.0]), 3.0),
     ]
 
 
