@@ -433,8 +433,10 @@ class HelicopterTurnIMM:
         freeze_fields(self, "t", "rate_t", "rate", "turn_prob", "turn_rate")
 
 
-def helicopter_cv_ct_filter(q_straight: float = 0.1, q_turn: float = HELI_TURN_ACCEL_PSD,
-                            turn_psd: float = TURN_RATE_PSD, switch: float = 0.05) -> IMMResult:
+def helicopter_cv_ct_filter(q_straight: float = 0.1,
+                            q_turn: float = HELI_TURN_ACCEL_PSD,
+                            turn_psd: float = TURN_RATE_PSD,
+                            switch: float = 0.05) -> IMMResult:
     r"""L'IMM vitesse constante / virage coordonné (:func:`cv_ct_modes`, EKF dans l'IMM) sur les deux capteurs
     du vol SAMU 31 : :math:`C = [I_4\ 0]` (positions et vitesses mesurées, pas :math:`\omega`), écarts-types
     de mesure appris, pas variable :math:`\Delta t_k` passé en commande (``u = track.dt[:, None]``), a priori
@@ -445,11 +447,15 @@ def helicopter_cv_ct_filter(q_straight: float = 0.1, q_turn: float = HELI_TURN_A
 
     track = helicopter_track("both")
     _, sp, sv = fitted_parameters("both")
-    R = np.diag([sp**2] * 2 + [sv**2] * 2)                                 # positions (m), vitesses (m/s)
-    modes = cv_ct_modes(None, q_straight, q_turn, turn_psd, R, C=np.eye(5)[:4])  # état [e, n, v_e, v_n, ω]
-    x0, P0 = turn_state_prior(track.x0, track.P0)                          # ω₀ = 0
-    u = np.asarray(track.dt)[:, None]                                      # u_k = [Δt_k]
-    return imm_filter(modes, track.y, x0, P0, u, transition=imm_transition(switch), mu0=[1.0 - switch, switch])
+    # mesures : positions (m) et vitesses (m/s) ; état [e, n, v_e, v_n, ω]
+    R = np.diag([sp**2] * 2 + [sv**2] * 2)
+    modes = cv_ct_modes(None, q_straight, q_turn, turn_psd, R,
+                        C=np.eye(5)[:4])
+    x0, P0 = turn_state_prior(track.x0, track.P0)      # ω₀ = 0
+    u = np.asarray(track.dt)[:, None]                  # u_k = [Δt_k]
+    return imm_filter(modes, track.y, x0, P0, u,
+                      transition=imm_transition(switch),
+                      mu0=[1.0 - switch, switch])
 
 
 @lru_cache(maxsize=None)
