@@ -55,6 +55,7 @@ from .core.motion import (
     coordinated_turn,
     discretize,
 )
+from .core.motion import straight_flight  # issue 37 : régime « ligne droite » de l'IMM vitesse constante / virage
 from .filters.adaptive import AdaptiveResult, adaptive_kalman_filter
 from .filters.imm import IMMResult, imm_filter
 from .filters.particle import (
@@ -302,6 +303,7 @@ __all__ = [
     "constant_acceleration_sde",
     "constant_velocity_model",
     "coordinated_turn",
+    "straight_flight",
     "imm_filter",
     "IMMResult",
     "adaptive_kalman_filter",

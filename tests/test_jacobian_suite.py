@@ -285,3 +285,23 @@ CASES_TURN = [
 @pytest.mark.parametrize("case", CASES_TURN, ids=[c.name for c in CASES_TURN])
 def test_turn_jacobians_match_perturbation(case):
     test_analytic_jacobian_matches_perturbation(case)
+
+
+# --------------------------------------------------------------------------- issue 37 : virage coordonné à pas variable
+# coordinated_turn(None, …) et straight_flight(None, …) lisent Δt dans la commande u = [Δt] (instants irréguliers de
+# l'hélicoptère) : leur F à des pas courts et longs, et aux vitesses de rotation des développements limités.
+_turn_u = kc.coordinated_turn(None, 0.5, 1e-4, np.eye(4), C=np.eye(5)[:4])
+_straight_u = kc.straight_flight(None, 0.5, np.eye(2) * 25.0)
+CASES_TURN_STEP = [
+    _vector_case(f"virage coordonné à pas variable : F pour Δt = {h} s", lambda x, h=h: _turn_u.transition(x, [h]),
+                 lambda x, h=h: _turn_u.transition_jacobian(x, [h]), TURN_X)
+    for h in (0.4, 3.1, 8.0)
+] + [
+    _vector_case("ligne droite sur l'état du virage : F pour Δt = 2,3 s", lambda x: _straight_u.transition(x, [2.3]),
+                 lambda x: _straight_u.transition_jacobian(x, [2.3]), TURN_X),
+]
+
+
+@pytest.mark.parametrize("case", CASES_TURN_STEP, ids=[c.name for c in CASES_TURN_STEP])
+def test_variable_step_turn_jacobians_match_perturbation(case):
+    test_analytic_jacobian_matches_perturbation(case)

@@ -30,7 +30,10 @@ Modèles du cours (état rangé positions d'abord, puis vitesses : :math:`[p_1, 
 * :func:`constant_acceleration` — accélération presque constante, *jerk* blanc de densité :math:`q`
   (m²/s⁵) ;
 * :func:`coordinated_turn` — virage coordonné à vitesse de rotation :math:`\omega` inconnue (état
-  :math:`[p_x, p_y, v_x, v_y, \omega]`), modèle **non linéaire** : transition exacte :func:`turn_transition`.
+  :math:`[p_x, p_y, v_x, v_y, \omega]`), modèle **non linéaire** : transition exacte :func:`turn_transition` ;
+  :func:`straight_flight` — la ligne droite sur le même état (:math:`\omega^+ = 0`), l'autre régime d'un IMM
+  vitesse constante / virage. Les deux acceptent un pas variable (``dt=None`` : :math:`\Delta t_k` lu dans
+  la commande :math:`u_k = [\Delta t_k]`, bruit par le gain :func:`turn_noise_gain`).
 """
 
 from __future__ import annotations
@@ -63,6 +66,8 @@ __all__ = [
     "turn_transition",
     "turn_jacobian",
     "coordinated_turn",
+    "straight_flight",
+    "turn_noise_gain",
 ]
 
 
@@ -349,29 +354,139 @@ def turn_jacobian(x: Any, dt: float) -> np.ndarray:
     ])
 
 
-def coordinated_turn(dt: Any, accel_psd: Any, turn_psd: Any, R: Any) -> NonlinearModel:
-    r"""Le virage coordonné comme :class:`~kalman_course.core.models.NonlinearModel` (pas ``dt`` fixe) :
-    transition exacte :func:`turn_transition` et sa jacobienne, mesure de la position
-    :math:`y = [p_x, p_y] + \psi`, :math:`\psi \sim \mathcal N(0, R)` (R (2, 2)).
+def _turn_measurement(C: Any) -> np.ndarray:
+    r"""La matrice de mesure (m, 5) des modèles sur l'état du virage : :math:`[I_2\ 0]` (la position) par
+    défaut ; ``C`` (m, 5) sinon (par exemple :math:`[I_4\ 0]` : positions et vitesses)."""
+    if C is None:
+        return np.eye(5)[:2]
+    return as_matrix("C", C, None, 5)
+
+
+def _command_step(u: Any) -> float:
+    r"""Le pas :math:`\Delta t` (s) lu dans la commande ``u`` = :math:`[\Delta t]` d'un modèle à pas variable."""
+    h = float(np.asarray(u, dtype=float).reshape(-1)[0]) if u is not None else float("nan")
+    if not h > 0.0 or not np.isfinite(h):
+        got = "aucune commande" if u is None else f"Δt = {h!r} s"
+        raise KalmanInputError(
+            "« u » doit contenir le pas de temps Δt (s, > 0) de chaque prédiction : avec dt=None, le modèle "
+            f"lit son pas dans la commande, u = dt[:, None] ; reçu {got}."
+        )
+    return h
+
+
+def turn_noise_gain(dt: float) -> np.ndarray:
+    r"""Gain :math:`W(\Delta t)` (5, 5) du bruit d'état des modèles à pas variable (:func:`coordinated_turn`,
+    :func:`straight_flight` avec ``dt=None``) : le bruit :math:`W\phi`, :math:`\phi \sim
+    \mathcal N(0, \operatorname{diag}(q, q, q, q, q_\omega))`, a la covariance du modèle à pas fixe,
+    :math:`WQW^T = \operatorname{diag}(Q_{cv}(\Delta t), q_\omega\Delta t)`. Sur chaque axe, :math:`W` est
+    le facteur de Cholesky, en forme close, de la covariance de densité 1 de :func:`constant_velocity` :
+
+    .. math::
+
+        \begin{bmatrix} \Delta t^3/3 & \Delta t^2/2 \\ \Delta t^2/2 & \Delta t \end{bmatrix}
+        = \begin{bmatrix} a & 0 \\ b & c \end{bmatrix}\begin{bmatrix} a & b \\ 0 & c \end{bmatrix},\quad
+        a = \sqrt{\Delta t^3/3},\ b = \tfrac{\sqrt 3}{2}\sqrt{\Delta t},\ c = \tfrac12\sqrt{\Delta t}
+
+    (état :math:`[p_x, p_y, v_x, v_y, \omega]`, bruit rangé de même), et :math:`\sqrt{\Delta t}` pour
+    :math:`\omega`."""
+    r = np.sqrt(dt)
+    a, b, c = r * dt / np.sqrt(3.0), 0.5 * np.sqrt(3.0) * r, 0.5 * r
+    W = np.zeros((5, 5))
+    W[0, 0] = W[1, 1] = a
+    W[2, 0] = W[3, 1] = b
+    W[2, 2] = W[3, 3] = c
+    W[4, 4] = r
+    return W
+
+
+def _straight_matrix(dt: float) -> np.ndarray:
+    r""":math:`A_0(\Delta t)` (5, 5) de :func:`straight_flight` : vitesse constante, :math:`\omega^+ = 0`."""
+    A = np.eye(5)
+    A[0, 2] = A[1, 3] = dt
+    A[4, 4] = 0.0
+    return A
+
+
+def coordinated_turn(dt: Any, accel_psd: Any, turn_psd: Any, R: Any, *, C: Any = None) -> NonlinearModel:
+    r"""Le virage coordonné comme :class:`~kalman_course.core.models.NonlinearModel` : transition exacte
+    :func:`turn_transition` et sa jacobienne :func:`turn_jacobian`, mesure linéaire
+    :math:`y = Cx + \psi`, :math:`\psi \sim \mathcal N(0, R)`, avec par défaut :math:`C = [I_2\ 0]` (la
+    position, R (2, 2)) ; ``C`` (m, 5) pour d'autres capteurs (:math:`[I_4\ 0]` : positions et vitesses).
 
     Bruit d'état : accélération blanche de densité ``accel_psd`` (m²/s³) sur chaque axe, comme
     :func:`constant_velocity`, et vitesse de rotation en marche aléatoire de densité ``turn_psd``
-    (rad²/s³) : :math:`Q = \operatorname{diag}(Q_{cv}, q_\omega\Delta t)` (l'approximation usuelle, qui
-    ignore le couplage entre rotation et position pendant le pas)."""
-    h = float(time_steps("dt", dt))
-    _, Q_cv = constant_velocity(h, accel_psd, 2)
+    (rad²/s³) : :math:`Q = \operatorname{diag}(Q_{cv}(\Delta t), q_\omega\Delta t)` (l'approximation
+    usuelle, qui ignore le couplage entre rotation et position pendant le pas).
+
+    ``dt`` : le pas (s), fixe ; ou ``None`` : **pas variable**, lu dans la commande
+    :math:`u_k = [\Delta t_k]` (``n_control = 1`` : passez ``u = dt[:, None]`` au filtre, la ligne ``k``
+    menant à la mesure ``y[k]``). Un :class:`NonlinearModel` n'a pas d'axe des temps : :math:`f(x, u)` et
+    sa jacobienne lisent :math:`\Delta t` dans :math:`u`, et le bruit passe par le gain
+    :math:`W(\Delta t)` = :func:`turn_noise_gain` (``f_noise_jacobian``), avec
+    :math:`Q = \operatorname{diag}(q, q, q, q, q_\omega)` constante : :math:`WQW^T` est la covariance du
+    pas fixe, pour chaque :math:`\Delta t`."""
+    C_arr = _turn_measurement(C)
+    R_arr = check_pd("R", as_square_matrix("R", R, C_arr.shape[0]))
+    q, q_w = _density("accel_psd", accel_psd), _density("turn_psd", turn_psd)
+    h = (lambda x: np.asarray(x).dot(C_arr.T))
+    if dt is None:
+        return NonlinearModel(
+            lambda x, u: turn_transition(x, _command_step(u)), h, np.diag([q] * 4 + [q_w]), R_arr,
+            f_jacobian=lambda x, u: turn_jacobian(x, _command_step(u)), h_jacobian=C_arr,
+            f_noise_jacobian=lambda x, u: turn_noise_gain(_command_step(u)), n_state=5, n_control=1,
+            vectorized=True,
+        )
+    step = float(time_steps("dt", dt))
+    _, Q_cv = constant_velocity(step, q, 2)
     Q = np.zeros((5, 5))
     Q[:4, :4] = Q_cv
-    Q[4, 4] = _density("turn_psd", turn_psd) * h
-    R_arr = check_pd("R", as_square_matrix("R", R, 2))
-    C = np.zeros((2, 5))
-    C[0, 0] = C[1, 1] = 1.0
+    Q[4, 4] = q_w * step
     return NonlinearModel(
-        lambda x, u: turn_transition(x, h),
-        lambda x: x[..., :2] if np.ndim(x) > 1 else np.asarray(x)[:2],
+        lambda x, u: turn_transition(x, step),
+        h,
         Q,
         R_arr,
-        f_jacobian=lambda x, u: turn_jacobian(x, h),
-        h_jacobian=C,
+        f_jacobian=lambda x, u: turn_jacobian(x, step),
+        h_jacobian=C_arr,
         vectorized=True,
     )
+
+
+def straight_flight(dt: Any, accel_psd: Any, R: Any, *, C: Any = None) -> NonlinearModel:
+    r"""La vitesse presque constante **sur l'état du virage coordonné** :math:`[p_x, p_y, v_x, v_y, \omega]` :
+    le régime « ligne droite » d'un IMM vitesse constante / virage coordonné, dont les régimes doivent
+    partager leur état. La vitesse de rotation y est **remise à zéro** à chaque pas :
+
+    .. math::
+
+        p^+ = p + \Delta t\, v,\qquad v^+ = v,\qquad \omega^+ = 0,\qquad
+        Q = \operatorname{diag}(Q_{cv}(\Delta t), 0)
+
+    (:math:`x^+ = A_0x + \phi` : linéaire, et c'est :func:`turn_transition` en :math:`\omega = 0` pour
+    :math:`p` et :math:`v`). Choix : dans ce régime la cible ne tourne pas, :math:`\omega = 0` exactement
+    (variance nulle) ; l'estimation combinée de l'IMM vaut alors :math:`\hat\omega = \mu_{ct}\hat\omega_{ct}`,
+    et le régime virage, qui repart du mélange, voit sa vitesse de rotation tirée vers 0 tant que la ligne
+    droite domine. (L'autre choix usuel, :math:`\omega^+ = \omega` gelée et inutilisée, garde une vitesse de
+    rotation que rien n'observe dans ce régime.)
+
+    Mêmes arguments que :func:`coordinated_turn` (``dt=None`` : pas lu dans la commande
+    :math:`u_k = [\Delta t_k]`, bruit par le gain :func:`turn_noise_gain`, :math:`Q = \operatorname{diag}
+    (q, q, q, q, 0)`). Un :class:`NonlinearModel` (linéaire en fait) pour qu'il se joigne aux régimes non
+    linéaires de l'IMM, qui les veut tous constants ou tous du même type."""
+    C_arr = _turn_measurement(C)
+    R_arr = check_pd("R", as_square_matrix("R", R, C_arr.shape[0]))
+    q = _density("accel_psd", accel_psd)
+    h = (lambda x: np.asarray(x).dot(C_arr.T))
+    if dt is None:
+        return NonlinearModel(
+            lambda x, u: np.asarray(x).dot(_straight_matrix(_command_step(u)).T), h, np.diag([q] * 4 + [0.0]),
+            R_arr, f_jacobian=lambda x, u: _straight_matrix(_command_step(u)), h_jacobian=C_arr,
+            f_noise_jacobian=lambda x, u: turn_noise_gain(_command_step(u)), n_state=5, n_control=1,
+            vectorized=True,
+        )
+    step = float(time_steps("dt", dt))
+    A = _straight_matrix(step)
+    Q = np.zeros((5, 5))
+    Q[:4, :4] = constant_velocity(step, q, 2).Q
+    return NonlinearModel(lambda x, u: np.asarray(x).dot(A.T), h, Q, R_arr, f_jacobian=A, h_jacobian=C_arr,
+                          vectorized=True)

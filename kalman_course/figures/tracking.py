@@ -309,5 +309,35 @@ def helicopter_imm_figure():
     return fig
 
 
+@register("manoeuvre-imm-virage", chapter=MANOEUVRE_CHAPTER,
+          title="L'IMM vitesse constante / virage coordonné sur l'hélicoptère : vitesse de rotation estimée "
+                "et probabilités des régimes")
+def helicopter_turn_imm_figure():
+    h = man.helicopter_turn_imm()
+    cvcv = man.helicopter_imm()
+    res = h.result
+    fig, axes = new_figure(2, 1, width=9.0, height=6.2, sharex=True)
+    ax = axes[0]
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.plot(h.rate_t, h.rate, color="black", lw=1.0, label="mesurée (messages de vitesse)")
+    ax.plot(h.t, np.rad2deg(res.x[:, 4]), color="tab:blue", lw=1.3, label="estimée par l'IMM CV/CT, ω̂")
+    ax.set_ylabel("vitesse de rotation ω (°/s)")
+    ax.set_title(f"Vitesse de rotation, positive vers la gauche : corrélation {fr(h.rate_correlation, '.2f')}",
+                 fontsize=9)
+    ax.legend(loc="lower left", fontsize=8, ncol=2)
+    _grid(ax)
+    ax = axes[1]
+    ax.fill_between(h.t, 0.0, res.mu[:, 1], color="tab:blue", alpha=0.3, lw=0, label="μ(virage), IMM CV/CT")
+    ax.plot(cvcv.t, cvcv.result.mu[:, 1], color="tab:red", lw=1.0, label="μ(agité), IMM CV/CV")
+    ax.set_ylim(0.0, 1.02)
+    ax.set_ylabel("probabilité du régime (sans unité)")
+    ax.set_xlabel("temps (s)")
+    ax.set_title(f"Corrélation avec |ω| mesurée : {fr(h.correlation, '.2f')} (virage), "
+                 f"{fr(h.correlation_cvcv, '.2f')} (agité)", fontsize=9)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=2, fontsize=8)
+    _grid(ax)
+    return fig
+
+
 __all__ = ["helicopter_flight", "helicopter_uncertainty", "two_sensors", "gate_figure", "lag_figure",
-           "comparison_figure", "helicopter_imm_figure"]
+           "comparison_figure", "helicopter_imm_figure", "helicopter_turn_imm_figure"]
