@@ -99,7 +99,7 @@ class Table:
             "<tr>" + "".join(f"<td>{_html_cell(self.cell(r, c))}</td>" for c in range(len(self.headers))) + "</tr>"
             for r in range(self.n_rows)
         )
-        return f'<table class="table kc-table"><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>'
+        return f'<table class="table dataframe kc-table"><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>'
 
     def _repr_html_(self) -> str:
         return self.to_html()

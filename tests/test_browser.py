@@ -1050,6 +1050,26 @@ _PHONE = r"""() => {
 }"""
 
 
+#: Contraste des cellules de tableau (texte contre le premier fond opaque au-dessus d'elles), en mode sombre :
+#: axe-core range ces nœuds en « à revoir » quand le fond vient d'un ancêtre (sortie HTML de myst-nb) et ne les
+#: signale pas ; un tableau kc.Table avait son texte blanc sur le fond clair de la sortie.
+_TABLE_CONTRAST = r"""() => {
+  const rgb = (c) => (c.match(/[\d.]+/g) || []).map(Number);
+  const lum = ([r, g, b]) => { const f = (v) => { v /= 255; return v <= 0.03928 ? v / 12.92 : ((v + 0.055) / 1.055) ** 2.4; };
+    return 0.2126 * f(r) + 0.7152 * f(g) + 0.0722 * f(b); };
+  const bad = [];
+  for (const cell of document.querySelectorAll('main td, main th')) {
+    if (!cell.textContent.trim()) continue;
+    let e = cell, bg = null;
+    while (e && !bg) { const c = rgb(getComputedStyle(e).backgroundColor); if (c.length === 3 || (c.length === 4 && c[3] > 0.5)) bg = c; e = e.parentElement; }
+    bg = bg || [255, 255, 255];
+    const [a, b] = [lum(rgb(getComputedStyle(cell).color).slice(0, 3)), lum(bg.slice(0, 3))];
+    const ratio = (Math.max(a, b) + 0.05) / (Math.min(a, b) + 0.05);
+    if (ratio < 4.5) bad.push(cell.textContent.trim().slice(0, 20) + ' (' + ratio.toFixed(1) + ')');
+  }
+  return bad;
+}"""
+
 def _check_phone(site: Site, html_file: Path, visit: Visit, problems: list[str], report: list[str]) -> None:
     """Sur un téléphone (390 × 844), en mode sombre : la page ne déborde pas de l'écran, les figures tiennent
     dans la colonne, les curseurs ne se chevauchent pas et montrent leur valeur, chaque équation trop large
@@ -1077,6 +1097,9 @@ def _check_phone(site: Site, html_file: Path, visit: Visit, problems: list[str],
     violations = serious(axe_violations(page))
     for v in violations:
         problems.append(f"{name} : axe-core (mode sombre) « {v['id']} » ({v['nodes']}) {v['examples']}")
+    faint = page.evaluate(_TABLE_CONTRAST)
+    if faint:
+        problems.append(f"{name} : cellules de tableau illisibles en mode sombre (contraste < 4,5) {faint[:4]}")
     for err in page_errors(visit, html_file.read_text()):
         problems.append(f"{name} : {err}")
     report.append(f"  {name:38s} axe-core (sombre, téléphone) : "
