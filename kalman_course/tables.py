@@ -9,6 +9,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from .core.validation import KalmanInputError
+from .typography import apply_rules
 
 __all__ = ["Table"]
 
@@ -17,11 +18,14 @@ _FIELD = re.compile(r"\{:([^{}]*)\}")
 
 
 def _html_cell(text: str) -> str:
-    """Échappe le HTML hors des formules ; ``$…$`` devient ``\\(…\\)``."""
+    """Échappe le HTML hors des formules, avec la typographie française du texte courant
+    (:func:`~kalman_course.typography.apply_rules` : apostrophe « ’ », espaces insécables ; la sortie HTML
+    d'une cellule échappe à l'extension Sphinx qui la donne au reste du livre) ; ``$…$`` devient
+    ``\\(…\\)``."""
     parts = re.split(r"\$([^$]+)\$", text)
     out = []
     for i, part in enumerate(parts):
-        out.append(f"\\({html.escape(part, quote=False)}\\)" if i % 2 else html.escape(part, quote=False))
+        out.append(f"\\({html.escape(part, quote=False)}\\)" if i % 2 else html.escape(apply_rules(part), quote=False))
     return "".join(out)
 
 

@@ -191,6 +191,11 @@ def test_table_cells_are_french():
     assert f"3,39{NN}×{NN}10⁻⁴" in table.to_html() and "." not in table.to_markdown().replace("---:", "")
     with pytest.raises(kc.KalmanInputError, match="champ"):
         kc.Table(["a"], [[1.0]], ["%.3f"])
+    # la sortie HTML d'une cellule n'est pas relue par l'extension de typographie : la table s'en charge,
+    # hors formules
+    typed = kc.Table(["pas sous l'intervalle", "part (%)", "$x'$"], [["l'EKF : 12 %"], [3.0], [1.0]]).to_html()
+    assert "pas sous l’intervalle" in typed and "l’EKF\u00a0: 12\u202f%" in typed and "part (%)" in typed
+    assert "\\(x'\\)" in typed and "'" not in typed.replace("\\(x'\\)", "")
 
 
 def test_bokeh_tick_formatter_runs_in_javascript():
