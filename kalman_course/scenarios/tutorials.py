@@ -141,9 +141,9 @@ class ThreeSteps:
     R_new: float
 
 
-def three_step_smoothing() -> ThreeSteps:
-    """Les trois pas du TD 3 : :func:`kalman_filter`, :func:`rts_smoother` et l'étape M du paquet."""
-    c = THREE_STEPS
+def _scalar_smoothing(c: dict) -> ThreeSteps:
+    """Filtre, lisseur RTS et étape M de R (paquet) sur le modèle scalaire A = C = 1 décrit par ``c``
+    (Q, R, y, x0, P0)."""
     model = LinearGaussianModel(1.0, 1.0, c["Q"], c["R"])
     y = np.array(c["y"])[:, None]
     res = kalman_filter(model, y, [c["x0"]], [[c["P0"]]])
@@ -151,6 +151,11 @@ def three_step_smoothing() -> ThreeSteps:
     new = em_step(model, y, [c["x0"]], [[c["P0"]]], None)[1]
     return ThreeSteps(res.x[:, 0], res.P[:, 0, 0], res.x_pred[:, 0], res.P_pred[:, 0, 0], sm.x[:, 0],
                       sm.P[:, 0, 0], sm.G[:-1, 0, 0], float(new.R[0, 0]))
+
+
+def three_step_smoothing() -> ThreeSteps:
+    """Les trois pas du TD 3 : :func:`kalman_filter`, :func:`rts_smoother` et l'étape M du paquet."""
+    return _scalar_smoothing(THREE_STEPS)
 
 
 # --------------------------------------------------------------------------- TD 4 : pister des cibles réelles
@@ -276,14 +281,7 @@ def exam_range_update():
 
 def exam_smoothing() -> ThreeSteps:
     """Examen, exercice 3 : deux pas de filtre, le lisseur RTS et l'étape M de R (paquet)."""
-    c = EXAM_SMOOTHING
-    model = LinearGaussianModel(1.0, 1.0, c["Q"], c["R"])
-    y = np.array(c["y"])[:, None]
-    res = kalman_filter(model, y, [c["x0"]], [[c["P0"]]])
-    sm = rts_smoother(model, res)
-    new = em_step(model, y, [c["x0"]], [[c["P0"]]], None)[1]
-    return ThreeSteps(res.x[:, 0], res.P[:, 0, 0], res.x_pred[:, 0], res.P_pred[:, 0, 0], sm.x[:, 0],
-                      sm.P[:, 0, 0], sm.G[:-1, 0, 0], float(new.R[0, 0]))
+    return _scalar_smoothing(EXAM_SMOOTHING)
 
 
 def exam_tracking() -> dict:
